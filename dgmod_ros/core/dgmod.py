@@ -1,0 +1,415 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""The robust dual-graph regularized separation model and its ADMM solver."""
+
+from dataclasses import dataclass, fields, replace
+
+import numpy as np
+
+from .graphs import spatial_laplacian, temporal_laplacian
+from .linalg import relative_change, shrink
+
+
+@dataclass
+class ADMMState:
+    """
+    Every iterate of Algorithm 1; the unit a warm start hands over.
+
+    All arrays are ``n x m`` float32 except ``weights`` (length m).
+    """
+
+    background: np.ndarray      # L
+    foreground: np.ndarray      # S
+    low_rank: np.ndarray        # U, the split copy of L
+    noise: np.ndarray           # V = D - L - S
+    dual_low_rank: np.ndarray   # Y1, scaled dual of U = L
+    dual_noise: np.ndarray      # Y2, scaled dual of D - L - S = V
+    weights: np.ndarray         # w of the weighted nuclear norm
+
+    def shifted(self, count, fill_column):
+        """
+        State of a window that dropped its ``count`` oldest frames.
+
+        The new columns start from ``fill_column`` (background and low-rank
+        copy; a good guess is the newest background column) with zero
+        foreground, noise and duals: the solver only needs a close start.
+        """
+        if count <= 0:
+            return self
+        arrays = {}
+        for field in fields(self):
+            value = getattr(self, field.name)
+            if field.name == 'weights':
+                arrays[field.name] = value
+                continue
+            rolled = np.empty_like(value)
+            rolled[:, :-count] = value[:, count:]
+            if field.name in ('background', 'low_rank'):
+                rolled[:, -count:] = fill_column[:, None]
+            else:
+                rolled[:, -count:] = 0.0
+            arrays[field.name] = rolled
+        return replace(self, **arrays)
+
+
+class DualGraphMOD:
+    r"""
+    Robust dual-graph regularized moving-object detection (Algorithm 1).
+
+    Separates a window ``D`` (n pixels x m frames, values in [0, 1]) into a
+    low-rank background ``L`` and a sparse foreground ``S`` by solving
+
+    .. math::
+
+        \min_{L,S} \|D - L - S\|_1 + \lambda_1 \|L\|_{W,*} + \lambda_2 \|S\|_1
+        + \frac{\gamma_1}{2} \mathrm{tr}(L^T \Phi_s L)
+        + \frac{\gamma_2}{2} \mathrm{tr}(L \Phi_t L^T)
+
+    with ADMM on the splitting ``U = L``, ``V = D - L - S``. The weighted
+    nuclear norm uses ``w_i = exp(-sigma_i^2 / s^2)`` recomputed from the last
+    U-step, so large (background) singular values are barely penalised.
+    ``Phi_s`` and ``Phi_t`` are the normalised Laplacians of the 4-neighbour
+    patch-similarity pixel graph and of the nearest-frames graph
+    (:mod:`dgmod_ros.core.graphs`). The steps are those of
+    ``docs/algorithm.md``, which corrects the paper's printed S- and V-steps.
+
+    Because both the fidelity and the foreground terms are l1, the optimum puts
+    the whole residual ``D - L`` into ``S`` when ``lambda2 < 1`` and into
+    ``V`` when ``lambda2 > 1``; keep ``lambda2 < 1`` for a foreground.
+
+    Parameters
+    ----------
+    lambda1 : float or None, default=None
+        Weight of the weighted nuclear norm. None: ``lambda2 * sqrt(max(n, m))``,
+        the balance of classical PCP.
+    lambda2 : float, default=0.5
+        Weight of ``||S||_1``; must be below 1 (see above).
+    gamma1 : float, default=0.5
+        Weight of the spatial graph term.
+    gamma2 : float, default=0.5
+        Weight of the temporal graph term.
+    rho1, rho2 : float, default=20.0
+        ADMM penalties of the two constraints (affect speed, not the optimum).
+    weight_scale : float or None, default=None
+        ``s`` in the weights. None: ``0.1 * sigma_1(D)``, so components with a
+        tenth of the window's energy or more are left almost unshrunk.
+    h_s, h_t : float or None, default=None
+        Graph filtering parameters; None is the data-driven median edge distance.
+    patch_size : int, default=3
+        Patch side ``p`` of the spatial similarity.
+    smoothing_sigma : float, default=0.0
+        Gaussian pre-smoothing (pixels) before patch distances; 0 is off.
+    temporal_neighbors : int, default=4
+        Frames joined to each frame in the temporal graph.
+    l_step : {'gradient', 'exact'}, default='gradient'
+        'gradient' takes the paper's ``inner_iter`` gradient steps of size
+        ``step_size``; 'exact' diagonalises ``Phi_t`` and solves the shifted
+        sparse systems by warm-started block conjugate gradients. With the
+        default penalties the subproblem's condition number is about 1.05,
+        so one gradient step is nearly exact: both need the same number of
+        sweeps and the gradient step is cheaper (docs/solver.md).
+    inner_iter : int, default=1
+        ``T_in``: CG iterations per L-step ('exact') or gradient steps ('gradient').
+    step_size : float or None, default=None
+        Gradient step; None is ``1 / Lipschitz`` of the L-subproblem.
+    svd : {'gram', 'full'}, default='gram'
+        'gram' takes the thin SVD through the m x m Gram matrix; 'full' calls
+        LAPACK on the tall matrix (the literal reference).
+    tol : float, default=1e-4
+        Stop when the relative changes of L and S and the relative primal
+        residuals ``||U - L|| / ||D||``, ``||D - L - S - V|| / ||D||`` are all
+        below ``tol``.
+    max_iter : int, default=300
+        ``T_out``, the limit on ADMM sweeps.
+
+    Attributes
+    ----------
+    background_ : ndarray (n, m)
+        ``L``.
+    foreground_ : ndarray (n, m)
+        ``S``.
+    state_ : ADMMState
+        All iterates, for a warm start of the next overlapping window.
+    n_iter_ : int
+        ADMM sweeps run.
+    info_ : int
+        0 converged; ``> 0`` stopped at ``max_iter`` (value = sweeps run);
+        ``-1`` a non-finite iterate appeared (results are the last finite ones).
+    history_ : dict of lists
+        Per sweep: 'change_L', 'change_S', 'residual_U', 'residual_V', 'rank'.
+    h_s_, h_t_, lambda1_, weight_scale_ : float
+        The parameters actually used after data-driven defaults.
+    singular_values_ : ndarray
+        Singular values of the last ``L - Y1``.
+
+    References
+    ----------
+    .. [1] J. Qin, R. Shen, R. Zhu, B. Xie, "Robust Dual-Graph Regularized
+       Moving Object Detection", arXiv:2204.11939, 2022 (``shared/paper``).
+    .. [2] S. Gu, L. Zhang, W. Zuo, X. Feng, "Weighted Nuclear Norm Minimization
+       with Application to Image Denoising", CVPR 2014.
+
+    """
+
+    def __init__(self, lambda1=None, lambda2=0.5, gamma1=0.5, gamma2=0.5, rho1=20.0, rho2=20.0,
+                 weight_scale=None, h_s=None, h_t=None, patch_size=3, smoothing_sigma=0.0,
+                 temporal_neighbors=4, l_step='gradient', inner_iter=1, step_size=None,
+                 svd='gram', tol=1e-4, max_iter=300):
+        self.lambda1 = lambda1
+        self.lambda2 = lambda2
+        self.gamma1 = gamma1
+        self.gamma2 = gamma2
+        self.rho1 = rho1
+        self.rho2 = rho2
+        self.weight_scale = weight_scale
+        self.h_s = h_s
+        self.h_t = h_t
+        self.patch_size = patch_size
+        self.smoothing_sigma = smoothing_sigma
+        self.temporal_neighbors = temporal_neighbors
+        self.l_step = l_step
+        self.inner_iter = inner_iter
+        self.step_size = step_size
+        self.svd = svd
+        self.tol = tol
+        self.max_iter = max_iter
+
+    # ------------------------------------------------------------------ checks
+    def _validate(self, data, frame_shape):
+        positive = ('lambda2', 'rho1', 'rho2', 'tol')
+        for name in positive:
+            value = getattr(self, name)
+            if not (np.isfinite(value) and value > 0):
+                raise ValueError(f'{name} must be a positive finite number, got {value!r}')
+        for name in ('gamma1', 'gamma2', 'smoothing_sigma'):
+            value = getattr(self, name)
+            if not (np.isfinite(value) and value >= 0):
+                raise ValueError(f'{name} must be a non-negative finite number, got {value!r}')
+        for name in ('lambda1', 'weight_scale', 'h_s', 'h_t', 'step_size'):
+            value = getattr(self, name)
+            if value is not None and not (np.isfinite(value) and value > 0):
+                raise ValueError(f'{name} must be None or a positive finite number, got {value!r}')
+        if self.l_step not in ('exact', 'gradient'):
+            raise ValueError(f"l_step must be 'exact' or 'gradient', got {self.l_step!r}")
+        if self.svd not in ('gram', 'full'):
+            raise ValueError(f"svd must be 'gram' or 'full', got {self.svd!r}")
+        if int(self.patch_size) != self.patch_size or self.patch_size < 1 \
+                or self.patch_size % 2 == 0:
+            raise ValueError(f'patch_size must be a positive odd integer, got {self.patch_size!r}')
+        for name in ('inner_iter', 'max_iter', 'temporal_neighbors'):
+            value = getattr(self, name)
+            if int(value) != value or value < 1:
+                raise ValueError(f'{name} must be a positive integer, got {value!r}')
+        data = np.asarray(data)
+        if data.ndim != 2:
+            raise ValueError(f'data must be 2-D (pixels x frames), got shape {data.shape}')
+        n, m = data.shape
+        if m < 2:
+            raise ValueError(f'data must hold at least 2 frames (columns), got {m}')
+        if len(frame_shape) != 2 or frame_shape[0] * frame_shape[1] != n:
+            raise ValueError(f'frame_shape {tuple(frame_shape)} does not match {n} pixels')
+        data = np.asarray(data, dtype=np.float32)
+        if not np.all(np.isfinite(data)):
+            raise ValueError('data contains NaN or Inf')
+        return data
+
+    # ------------------------------------------------------------------ steps
+    def _initial_state(self, data):
+        background = np.median(data, axis=1, keepdims=True).astype(np.float32)
+        background = np.repeat(background, data.shape[1], axis=1)
+        zeros = np.zeros_like(data)
+        return ADMMState(background=background, foreground=data - background,
+                         low_rank=background.copy(), noise=zeros, dual_low_rank=zeros.copy(),
+                         dual_noise=zeros.copy(),
+                         weights=np.ones(data.shape[1], dtype=np.float32))
+
+    def _weighted_svt(self, matrix, weights, threshold):
+        """Return ``A diag(shrink(sigma, w * t)) B^T``, the singular values and the rank kept."""
+        if self.svd == 'full':
+            left, sigma, right_t = np.linalg.svd(matrix, full_matrices=False)
+            shrunk = np.maximum(sigma - weights[:sigma.size] * threshold, 0)
+            keep = shrunk > 0
+            result = (left[:, keep] * shrunk[keep]) @ right_t[keep]
+            return result.astype(np.float32), sigma, int(np.count_nonzero(keep))
+        # U = Lh B diag(shrunk / sigma) B^T needs only the m x m eigenproblem.
+        gram = (matrix.T @ matrix).astype(np.float64)
+        eigval, eigvec = np.linalg.eigh(gram)
+        eigval = np.clip(eigval[::-1], 0.0, None)
+        eigvec = eigvec[:, ::-1]
+        sigma = np.sqrt(eigval)
+        shrunk = np.maximum(sigma - weights * threshold, 0.0)
+        keep = shrunk > 0
+        ratio = shrunk[keep] / sigma[keep]
+        mixing = (eigvec[:, keep] * ratio) @ eigvec[:, keep].T
+        return matrix @ mixing.astype(np.float32), sigma, int(np.count_nonzero(keep))
+
+    def _l_step(self, rhs, background, ops, c):
+        """Minimise the Lagrangian over L: ``g1 Phi_s L + g2 L Phi_t + c L = rhs``."""
+        g1, g2 = self.gamma1, self.gamma2
+        phi_s = ops['phi_s']
+        if self.l_step == 'gradient':
+            # The subproblem's Hessian has spectrum in [c, c + 2 g1 + 2 g2].
+            step = self.step_size or 1.0 / (2.0 * g1 + 2.0 * g2 + c)
+            x = background
+            for _ in range(self.inner_iter):
+                grad = x * c
+                grad -= rhs
+                if g1 > 0:
+                    grad += g1 * (phi_s @ x)
+                if g2 > 0:
+                    grad += g2 * (x @ ops['phi_t'])
+                grad *= -step
+                grad += x
+                x = grad
+            return x
+        # Exact: in the eigenbasis Q of Phi_t, column j of L Q solves the SPD
+        # system (g1 Phi_s + (g2 mu_j + c) I) z = (rhs Q)_j, condition number
+        # at most (2 g1 + c) / c; block CG runs the m systems together with
+        # per-column step sizes, warm-started from the previous L.
+        basis = ops['basis']
+        shifts = (g2 * ops['mu'] + c).astype(np.float32)
+        b = rhs @ basis
+        if g1 == 0:
+            b /= shifts
+            return b @ basis.T
+        z = background @ basis
+        r = b
+        r -= shifts * z
+        r -= g1 * (phi_s @ z)
+        p = r.copy()
+        rr = np.einsum('ij,ij->j', r, r)
+        for _ in range(self.inner_iter):
+            ap = phi_s @ p
+            ap *= g1
+            ap += shifts * p
+            pap = np.einsum('ij,ij->j', p, ap)
+            alpha = np.divide(rr, pap, out=np.zeros_like(rr), where=pap > 0)
+            z += alpha * p
+            ap *= alpha
+            r -= ap
+            rr_new = np.einsum('ij,ij->j', r, r)
+            beta = np.divide(rr_new, rr, out=np.zeros_like(rr), where=rr > 0)
+            p *= beta
+            p += r
+            rr = rr_new
+        return z @ basis.T
+
+    # ------------------------------------------------------------------ public
+    def build_operators(self, data, frame_shape):
+        """Graph Laplacians and the temporal eigenbasis for one window."""
+        phi_s, self.h_s_ = spatial_laplacian(data, frame_shape, self.patch_size, self.h_s,
+                                             self.smoothing_sigma)
+        phi_t, self.h_t_ = temporal_laplacian(data, self.temporal_neighbors, self.h_t)
+        mu, basis = np.linalg.eigh(phi_t.toarray())
+        return {'phi_s': phi_s, 'phi_t': phi_t.astype(np.float32).toarray(),
+                'basis': basis.astype(np.float32), 'mu': mu}
+
+    def fit(self, data, frame_shape, init=None):
+        """
+        Separate one window.
+
+        Parameters
+        ----------
+        data : array-like (n, m)
+            Frames as columns, values in [0, 1], pixels in row-major order.
+        frame_shape : tuple (n1, n2)
+            Rows and columns of one frame; ``n1 * n2 == n``.
+        init : ADMMState or None
+            Warm start (for example ``previous.state_.shifted(stride, column)``);
+            None starts from the per-pixel temporal median.
+
+        Returns
+        -------
+        self
+
+        """
+        data = self._validate(data, frame_shape)
+        n, m = data.shape
+        if init is not None and init.background.shape != data.shape:
+            raise ValueError(f'init state has shape {init.background.shape}, data {data.shape}')
+        self.lambda1_ = (self.lambda1 if self.lambda1 is not None
+                         else self.lambda2 * np.sqrt(max(n, m)))
+        ops = self.build_operators(data, frame_shape)
+        data_norm = float(np.linalg.norm(data)) or 1.0
+        if self.weight_scale is None:
+            # ||D||_2 from the Gram matrix's top eigenvalue: an m x m problem.
+            top = np.linalg.eigvalsh((data.T @ data).astype(np.float64))[-1]
+            self.weight_scale_ = 0.1 * float(np.sqrt(max(top, 0.0))) or 1.0
+        else:
+            self.weight_scale_ = float(self.weight_scale)
+
+        state = self._initial_state(data) if init is None else replace(init)
+        L = state.background.copy()
+        # A warm start's new columns know nothing of the new frames: putting
+        # the whole residual into S satisfies D = L + S + V exactly.
+        S = data - L - state.noise if init is not None else state.foreground.copy()
+        U, V = state.low_rank.copy(), state.noise.copy()
+        Y1, Y2 = state.dual_low_rank.copy(), state.dual_noise.copy()
+        weights = state.weights
+        rho1, rho2 = float(self.rho1), float(self.rho2)
+        history = {k: [] for k in ('change_L', 'change_S', 'residual_U', 'residual_V', 'rank')}
+        self.info_ = self.max_iter
+        sigma = np.zeros(m)
+        # Scratch buffers: a sweep is ~25 passes over n x m arrays, and
+        # allocating each temporary would cost as much as the arithmetic.
+        rhs = np.empty_like(data)
+        work = np.empty_like(data)
+        residual = np.empty_like(data)
+        S_new = np.empty_like(data)
+        V_new = np.empty_like(data)
+        for _ in range(self.max_iter):
+            # 1. L-step, right-hand side rho1 (U + Y1) + rho2 (D - S - V + Y2).
+            np.add(U, Y1, out=rhs)
+            rhs *= rho1
+            np.subtract(data, S, out=work)
+            work -= V
+            work += Y2
+            work *= rho2
+            rhs += work
+            L_new = self._l_step(rhs, L, ops, rho1 + rho2)
+            # 2. S-step.
+            np.subtract(data, L_new, out=residual)                    # D - L
+            np.subtract(residual, V, out=work)
+            work += Y2
+            shrink(work, self.lambda2 / rho2, out=S_new)
+            # 3. U-step (weights from the previous sweep), then new weights.
+            np.subtract(L_new, Y1, out=work)
+            U_new, sigma, rank = self._weighted_svt(work, weights, self.lambda1_ / rho1)
+            # 4. V-step.
+            np.subtract(residual, S_new, out=work)
+            work += Y2
+            shrink(work, 1.0 / rho2, out=V_new)
+            if not (np.isfinite(sigma).all() and np.isfinite(U_new).all()
+                    and np.isfinite(S_new).all()):
+                self.info_ = -1
+                break
+            weights = np.exp(-(sigma / self.weight_scale_) ** 2).astype(np.float32)
+            change_L = relative_change(L_new, L)
+            change_S = relative_change(S_new, S)
+            S, S_new = S_new, S
+            V, V_new = V_new, V
+            L, U = L_new, U_new
+            # 5. Dual updates with the primal residuals.
+            np.subtract(U, L, out=work)
+            residual_U = float(np.linalg.norm(work)) / data_norm
+            Y1 += work
+            residual -= S
+            residual -= V                                             # D - L - S - V
+            residual_V = float(np.linalg.norm(residual)) / data_norm
+            Y2 += residual
+            for key, value in (('change_L', change_L), ('change_S', change_S),
+                               ('residual_U', residual_U), ('residual_V', residual_V),
+                               ('rank', rank)):
+                history[key].append(value)
+            # 6. Stop.
+            if max(change_L, change_S, residual_U, residual_V) < self.tol:
+                self.info_ = 0
+                break
+        self.n_iter_ = len(history['change_L'])
+        self.history_ = history
+        self.singular_values_ = sigma
+        self.state_ = ADMMState(background=L, foreground=S, low_rank=U, noise=V,
+                                dual_low_rank=Y1, dual_noise=Y2, weights=weights)
+        self.background_ = L
+        self.foreground_ = S
+        return self

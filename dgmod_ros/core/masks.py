@@ -1,0 +1,109 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""
+The one rule that turns a foreground estimate into a binary mask.
+
+Every method in the package goes through :class:`MaskRule`, so comparisons
+measure the separation, not the thresholding.
+
+Rule: a pixel is foreground when the magnitude of its foreground estimate
+(``|S|``; for colour, the largest over the channels) exceeds a threshold
+``tau``. With ``threshold='auto'``, ``tau = max(min_threshold, k * sigma)``
+where ``sigma = 1.4826 * MAD(R)`` is a robust estimate of the noise level of
+the residual ``R = D - L`` over the whole window (MAD: median absolute
+deviation from the median; 1.4826 makes it the standard deviation for
+Gaussian noise). The magnitude is resized to the output size (bilinear) before
+thresholding, then an optional morphological opening (speckle) and closing
+(holes) with an elliptic ``morph_size x morph_size`` kernel is applied.
+"""
+
+import cv2
+import numpy as np
+
+# Enough samples for a stable median; larger windows are subsampled with a
+# fixed stride so that the estimate is deterministic.
+_MAD_SAMPLES = 200_000
+
+
+def robust_sigma(values):
+    """``1.4826 * median(|x - median(x)|)`` over a deterministic subsample."""
+    flat = np.asarray(values, dtype=np.float32).ravel()
+    if flat.size == 0:
+        return 0.0
+    if flat.size > _MAD_SAMPLES:
+        flat = flat[::flat.size // _MAD_SAMPLES + 1]
+    center = np.median(flat)
+    return float(1.4826 * np.median(np.abs(flat - center)))
+
+
+class MaskRule:
+    """
+    Threshold plus clean-up that makes masks from foreground magnitudes.
+
+    Parameters
+    ----------
+    threshold : float or 'auto', default='auto'
+        Fixed ``tau`` on data in [0, 1], or 'auto' for the residual-based rule.
+    k : float, default=5.0
+        Multiple of the robust noise level used by the 'auto' rule.
+    min_threshold : float, default=0.04
+        Floor of the 'auto' threshold, so a noiseless scene does not flag
+        compression artefacts.
+    morph_size : int, default=3
+        Kernel side of the opening and closing; 0 or 1 disables clean-up.
+
+    """
+
+    def __init__(self, threshold='auto', k=5.0, min_threshold=0.04, morph_size=3):
+        self.threshold = threshold
+        self.k = k
+        self.min_threshold = min_threshold
+        self.morph_size = morph_size
+
+    def validate(self):
+        """Raise ``ValueError`` for an unusable parameter; return self."""
+        if isinstance(self.threshold, str):
+            if self.threshold != 'auto':
+                raise ValueError(f"threshold must be a positive number or 'auto', "
+                                 f'got {self.threshold!r}')
+        elif not (np.isfinite(self.threshold) and self.threshold > 0):
+            raise ValueError(f'threshold must be positive, got {self.threshold!r}')
+        if not (np.isfinite(self.k) and self.k > 0):
+            raise ValueError(f'k must be positive, got {self.k!r}')
+        if not (np.isfinite(self.min_threshold) and self.min_threshold >= 0):
+            raise ValueError(f'min_threshold must be non-negative, got {self.min_threshold!r}')
+        if int(self.morph_size) != self.morph_size or self.morph_size < 0:
+            raise ValueError(f'morph_size must be a non-negative integer, got {self.morph_size!r}')
+        return self
+
+    def estimate_threshold(self, residual):
+        """Return the threshold ``tau`` for a window whose residual ``D - L`` is ``residual``."""
+        if not isinstance(self.threshold, str):
+            return float(self.threshold)
+        return max(float(self.min_threshold), self.k * robust_sigma(residual))
+
+    def apply(self, magnitude, threshold, output_shape=None):
+        """
+        Binary mask (uint8, 0 or 255) of one frame's foreground magnitude.
+
+        Parameters
+        ----------
+        magnitude : ndarray (h, w)
+            Non-negative foreground magnitude at the processing size.
+        threshold : float
+            ``tau`` from :meth:`estimate_threshold`.
+        output_shape : tuple (rows, cols) or None
+            Size of the returned mask (the input frame's); None keeps (h, w).
+
+        """
+        magnitude = np.asarray(magnitude, dtype=np.float32)
+        if output_shape is not None and magnitude.shape != tuple(output_shape):
+            magnitude = cv2.resize(magnitude, (output_shape[1], output_shape[0]),
+                                   interpolation=cv2.INTER_LINEAR)
+        mask = np.where(magnitude > threshold, np.uint8(255), np.uint8(0))
+        if self.morph_size > 1:
+            kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE,
+                                               (self.morph_size, self.morph_size))
+            mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, kernel)
+            mask = cv2.morphologyEx(mask, cv2.MORPH_CLOSE, kernel)
+        return mask

@@ -1,0 +1,95 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+from dgmod_ros.core.graphs import spatial_laplacian, temporal_laplacian
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+
+@pytest.fixture
+def window():
+    rng = np.random.default_rng(3)
+    frames = rng.random((12, 9, 7)).astype(np.float32)       # rows x cols x frames
+    frames[:, :4] += 0.8                                       # an edge the weights must see
+    return frames.reshape(-1, 7), (12, 9)
+
+
+def _check_normalized_laplacian(laplacian, degree_vector):
+    dense = laplacian.toarray().astype(np.float64)
+    assert np.allclose(dense, dense.T, atol=1e-6)
+    eigenvalues = np.linalg.eigvalsh(dense)
+    assert eigenvalues.min() > -1e-5                           # positive semi-definite
+    assert eigenvalues.max() < 2 + 1e-5                        # normalized: spectrum in [0, 2]
+    # W^(1/2) 1 spans the null space of I - W^-1/2 A W^-1/2.
+    null = np.sqrt(degree_vector)
+    assert np.linalg.norm(dense @ null) < 1e-5 * np.linalg.norm(null)
+
+
+def test_spatial_laplacian_properties(window):
+    data, shape = window
+    laplacian, h = spatial_laplacian(data, shape)
+    assert sp.issparse(laplacian) and laplacian.dtype == np.float32
+    assert laplacian.shape == (data.shape[0],) * 2
+    assert h > 0
+    adjacency = sp.eye(laplacian.shape[0]) - laplacian
+    # 4-neighbour graph: at most 4 off-diagonal entries per row.
+    off = adjacency.tocsr()
+    off.setdiag(0)
+    off.eliminate_zeros()
+    assert np.diff(off.indptr).max() <= 4
+    # Recover the degrees from the unnormalised weights to check the null space.
+    degrees = _degrees_from_normalized(laplacian)
+    _check_normalized_laplacian(laplacian, degrees)
+
+
+def _degrees_from_normalized(laplacian):
+    # The null vector of a connected normalized Laplacian is W^(1/2) 1; get it
+    # as the eigenvector of the smallest eigenvalue, squared.
+    values, vectors = np.linalg.eigh(laplacian.toarray().astype(np.float64))
+    return vectors[:, 0] ** 2
+
+
+def test_spatial_weights_follow_patch_similarity(window):
+    data, shape = window
+    laplacian, _ = spatial_laplacian(data, shape, patch_size=1, h=1.0)
+    dense = -laplacian.toarray()
+    cube = data.reshape(shape + (-1,))
+    idx = np.arange(shape[0] * shape[1]).reshape(shape)
+    # Same-side neighbours are more similar than neighbours across the edge,
+    # so (after normalisation) their coupling is stronger.
+    same = dense[idx[5, 1], idx[5, 2]]
+    across = dense[idx[5, 3], idx[5, 4]]
+    assert same > across
+    # With p = 1 and h = 1 the raw weight is exp(-sum_t (x_i - x_j)^2).
+    raw = np.exp(-np.sum((cube[5, 1] - cube[5, 2]) ** 2))
+    assert raw > np.exp(-np.sum((cube[5, 3] - cube[5, 4]) ** 2))
+
+
+def test_temporal_laplacian_properties(window):
+    data, _ = window
+    laplacian, h = temporal_laplacian(data, neighbors=4)
+    dense = laplacian.toarray()
+    m = data.shape[1]
+    assert dense.shape == (m, m) and h > 0
+    # Only frames within two steps are joined.
+    rows, cols = np.nonzero(dense)
+    assert np.abs(rows - cols).max() <= 2
+    values, vectors = np.linalg.eigh(dense)
+    _check_normalized_laplacian(laplacian, vectors[:, 0] ** 2)
+
+
+def test_default_filtering_parameter_is_median_edge_distance(window):
+    data, _ = window
+    gram = data.T.astype(np.float64) @ data
+    d2 = [gram[i, i] + gram[j, j] - 2 * gram[i, j]
+          for i in range(data.shape[1]) for j in range(i + 1, min(i + 3, data.shape[1]))]
+    _, h = temporal_laplacian(data, neighbors=4)
+    assert h == pytest.approx(np.sqrt(np.median(d2)), rel=1e-6)
+
+
+def test_smoothing_changes_weights_but_not_structure(window):
+    data, shape = window
+    plain, _ = spatial_laplacian(data, shape)
+    smooth, _ = spatial_laplacian(data, shape, smoothing_sigma=1.0)
+    assert plain.nnz == smooth.nnz
+    assert not np.allclose(plain.toarray(), smooth.toarray())
