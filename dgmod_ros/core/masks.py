@@ -46,7 +46,7 @@ class MaskRule:
         Fixed ``tau`` on data in [0, 1], or 'auto' for the residual-based rule.
     k : float, default=5.0
         Multiple of the robust noise level used by the 'auto' rule.
-    min_threshold : float, default=0.04
+    min_threshold : float, default=0.1
         Floor of the 'auto' threshold, so a noiseless scene does not flag
         compression artefacts.
     morph_size : int, default=3
@@ -54,7 +54,7 @@ class MaskRule:
 
     """
 
-    def __init__(self, threshold='auto', k=5.0, min_threshold=0.04, morph_size=3):
+    def __init__(self, threshold='auto', k=5.0, min_threshold=0.1, morph_size=3):
         self.threshold = threshold
         self.k = k
         self.min_threshold = min_threshold

@@ -74,7 +74,8 @@ def synthetic_scene(n_frames=120, shape=(120, 160), noise=0.01, drift=0.08, seed
         Mean intensity of the shape (dark clothing on a mid-grey scene).
     speed : float or None
         Columns per frame; None crosses the frame in 40 frames (about 1.3 s
-        at 30 frames/s, a brisk walk across a close camera's view).
+        at 30 frames/s, a brisk walk across a close camera's view). The shape
+        leaves on the right and comes back in from the left.
 
     """
     rng = np.random.default_rng(seed)
@@ -86,10 +87,10 @@ def synthetic_scene(n_frames=120, shape=(120, 160), noise=0.01, drift=0.08, seed
     masks = np.empty((n_frames, rows, cols), dtype=np.uint8)
     backgrounds = np.empty((n_frames, rows, cols), dtype=np.float32)
     tint = np.array([1.0, 0.97, 0.92], dtype=np.float32)  # the scene is slightly warm
-    span = cols - 0.5 * height
+    margin = 0.25 * height        # half the body width: the shape leaves the frame fully
     for t in range(n_frames):  # one vectorised frame per step
-        travel = (0.25 * height + speed * t) % (2 * span)
-        cx = travel if travel < span else 2 * span - travel
+        # Walks left to right, leaves the view and comes back in from the left.
+        cx = (speed * t + margin) % (cols + 2 * margin) - margin
         shape_mask = person_mask(shape, (0.55 * rows, cx), height)
         light = 1.0 + drift * (t / max(n_frames - 1, 1) - 0.5)
         grey = background * light

@@ -1,0 +1,121 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""
+Benchmark one window solve: speed, memory and accuracy against the literal reference.
+
+Window: 60 frames of 150 x 200 pixels (IBMtest2 frames resized; a synthetic
+scene when ../shared/data is absent), float32, tol 1e-4. Prints the median
+time of the fast solver, the time of the literal reference of the printed
+steps (gradient L-step, full SVD of the tall matrix) in the same process, their
+ratio, both F-measures against ground truth, and peak memory.
+
+Usage: python benchmarks/bench_solver.py [--repeats 5] [--tol 1e-4]
+"""
+
+import argparse
+from pathlib import Path
+import resource
+import statistics
+import sys
+import time
+import tracemalloc
+
+import cv2
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from dgmod_ros.core.dgmod import DualGraphMOD  # noqa: E402
+from dgmod_ros.core.masks import MaskRule  # noqa: E402
+from dgmod_ros.core.metrics import ConfusionCounts  # noqa: E402
+from dgmod_ros.core.runtime import keep_freed_memory  # noqa: E402
+from dgmod_ros.core.synthetic import synthetic_scene  # noqa: E402
+
+SHAPE = (150, 200)
+FRAMES = 60
+DATA = Path(__file__).resolve().parents[2] / 'shared' / 'data' / 'sbi_IBMtest2'
+
+
+def load_window():
+    """Return (data n x m, ground-truth masks, source name)."""
+    if (DATA / 'input').is_dir():
+        inputs = sorted((DATA / 'input').iterdir())[:FRAMES]
+        truths = sorted((DATA / 'groundtruth').iterdir())[:FRAMES]
+        frames = [cv2.imread(str(p), cv2.IMREAD_GRAYSCALE) for p in inputs]
+        masks = [cv2.imread(str(p), cv2.IMREAD_GRAYSCALE) for p in truths]
+        source = 'IBMtest2 frames 0-59 resized to 200 x 150'
+    else:
+        scene = synthetic_scene(n_frames=FRAMES, shape=SHAPE)
+        frames = [cv2.cvtColor(f, cv2.COLOR_RGB2GRAY) for f in scene.frames]
+        masks = list(scene.masks)
+        source = 'synthetic scene (shared data not found)'
+    small = [cv2.resize(f, SHAPE[::-1], interpolation=cv2.INTER_AREA) for f in frames]
+    data = np.stack([f.ravel() for f in small], axis=1).astype(np.float32) / 255.0
+    return data, masks, source
+
+
+def fmeasure(model, data, masks):
+    """Score the window's masks (default mask rule) at the ground truth's size."""
+    rule = MaskRule()
+    threshold = rule.estimate_threshold(data - model.background_)
+    counts = ConfusionCounts()
+    for j, truth in enumerate(masks):
+        magnitude = np.abs(model.foreground_[:, j]).reshape(SHAPE)
+        counts.add(rule.apply(magnitude, threshold, truth.shape), truth)
+    return counts.fmeasure
+
+
+def timed_fit(make_model, data, repeats):
+    times, model = [], None
+    for _ in range(repeats):
+        model = make_model()
+        started = time.perf_counter()
+        model.fit(data, SHAPE)
+        times.append(time.perf_counter() - started)
+    return times, model
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
+    parser.add_argument('--repeats', type=int, default=5)
+    parser.add_argument('--reference-repeats', type=int, default=2)
+    parser.add_argument('--tol', type=float, default=1e-4)
+    args = parser.parse_args(argv)
+    keep_freed_memory()
+    data, masks, source = load_window()
+    print(f'window: {source}; {data.shape[0]} pixels x {data.shape[1]} frames, float32, '
+          f'tol {args.tol:g}')
+
+    # Memory first: the process's peak RSS is a high-water mark, and the
+    # reference's full SVD would raise it.
+    tracemalloc.start()
+    DualGraphMOD(tol=args.tol).fit(data, SHAPE)
+    _, peak = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    print(f'peak memory of one solve: arrays {peak / 2**20:.0f} MB (tracemalloc); whole '
+          f'process {rss:.0f} MB peak RSS (interpreter, numpy, scipy, OpenCV included)')
+
+    fast_times, fast = timed_fit(lambda: DualGraphMOD(tol=args.tol), data, args.repeats)
+    ref_times, ref = timed_fit(
+        lambda: DualGraphMOD(tol=args.tol, l_step='gradient', inner_iter=1, svd='full'),
+        data, args.reference_repeats)
+    fast_median, ref_median = statistics.median(fast_times), statistics.median(ref_times)
+    print(f'fast solver     : median {fast_median:.3f} s over {len(fast_times)} runs '
+          f'({fast.n_iter_} sweeps, info {fast.info_}, '
+          f'{1e3 * fast_median / fast.n_iter_:.1f} ms/sweep), F {fmeasure(fast, data, masks):.3f}')
+    print(f'literal reference: median {ref_median:.3f} s over {len(ref_times)} runs '
+          f'({ref.n_iter_} sweeps, info {ref.info_}, '
+          f'{1e3 * ref_median / ref.n_iter_:.1f} ms/sweep), F {fmeasure(ref, data, masks):.3f}')
+    print(f'speed-up over the reference: {ref_median / fast_median:.1f}x '
+          f'(per sweep {ref_median / ref.n_iter_ / (fast_median / fast.n_iter_):.1f}x)')
+
+    loose_times, loose = timed_fit(lambda: DualGraphMOD(tol=1e-3), data, args.repeats)
+    print(f'fast solver at tol 1e-3 (the node default): median '
+          f'{statistics.median(loose_times):.3f} s ({loose.n_iter_} sweeps), '
+          f'F {fmeasure(loose, data, masks):.3f}')
+
+
+
+if __name__ == '__main__':
+    main()
