@@ -19,7 +19,7 @@ test: $(STAMP)
 	$(PY) -m pytest -q test $(PYTEST_ARGS)
 
 bench: $(STAMP)
-	$(PY) benchmarks/bench_solver.py
+	PYTHONPATH=. $(PY) benchmarks/bench_solver.py
 
 clean:
 	rm -rf $(VENV) out

@@ -9,27 +9,23 @@ time of the fast solver, the time of the literal reference of the printed
 steps (gradient L-step, full SVD of the tall matrix) in the same process, their
 ratio, both F-measures against ground truth, and peak memory.
 
-Usage: python benchmarks/bench_solver.py [--repeats 5] [--tol 1e-4]
+Usage (repo root): PYTHONPATH=. python benchmarks/bench_solver.py [--repeats 5] [--tol 1e-4]
 """
 
 import argparse
 from pathlib import Path
 import resource
 import statistics
-import sys
 import time
 import tracemalloc
 
 import cv2
+from dgmod_ros.core.dgmod import DualGraphMOD
+from dgmod_ros.core.masks import MaskRule
+from dgmod_ros.core.metrics import ConfusionCounts
+from dgmod_ros.core.runtime import keep_freed_memory
+from dgmod_ros.core.synthetic import synthetic_scene
 import numpy as np
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from dgmod_ros.core.dgmod import DualGraphMOD  # noqa: E402
-from dgmod_ros.core.masks import MaskRule  # noqa: E402
-from dgmod_ros.core.metrics import ConfusionCounts  # noqa: E402
-from dgmod_ros.core.runtime import keep_freed_memory  # noqa: E402
-from dgmod_ros.core.synthetic import synthetic_scene  # noqa: E402
 
 SHAPE = (150, 200)
 FRAMES = 60
@@ -114,7 +110,6 @@ def main(argv=None):
     print(f'fast solver at tol 1e-3 (the node default): median '
           f'{statistics.median(loose_times):.3f} s ({loose.n_iter_} sweeps), '
           f'F {fmeasure(loose, data, masks):.3f}')
-
 
 
 if __name__ == '__main__':
