@@ -175,7 +175,8 @@ class DualGraphMOD:
         self.max_iter = max_iter
 
     # ------------------------------------------------------------------ checks
-    def _validate(self, data, frame_shape):
+    def check_parameters(self):
+        """Raise ``ValueError`` naming the first unusable parameter; return self."""
         positive = ('lambda2', 'rho1', 'rho2', 'tol')
         for name in positive:
             value = getattr(self, name)
@@ -200,6 +201,10 @@ class DualGraphMOD:
             value = getattr(self, name)
             if int(value) != value or value < 1:
                 raise ValueError(f'{name} must be a positive integer, got {value!r}')
+        return self
+
+    def _validate(self, data, frame_shape):
+        self.check_parameters()
         data = np.asarray(data)
         if data.ndim != 2:
             raise ValueError(f'data must be 2-D (pixels x frames), got shape {data.shape}')

@@ -81,6 +81,8 @@ class WindowSnapshot:
     first_id: int
     last_id: int
     previous: object            # BackgroundModel or None, for the warm start
+    model: object               # the estimator configured when the snapshot was taken
+    mask_rule: object           # likewise the MaskRule
 
 
 class SolverFailure(RuntimeError):
@@ -97,6 +99,7 @@ class FrameResult:
     buffered: bool              # False if dropped from the window as motionless
     reset: bool                 # True if the window restarted (size or encoding change)
     model_ready: bool           # False while warming up (no solve yet)
+    solve_error: str = None     # set by process() when a due solve failed
 
 
 class SlidingWindowDetector:
@@ -175,9 +178,60 @@ class SlidingWindowDetector:
         if not self._validated:
             self.validate()
         if not hasattr(self, 'buffer_'):
-            self.model_ = self.model if self.model is not None else DualGraphMOD(tol=1e-3)
-            self.mask_rule_ = self.mask_rule or MaskRule()
+            self._build_helpers()
             self.reset()
+
+    def _build_helpers(self):
+        self.model_ = (self.model if self.model is not None
+                       else DualGraphMOD(tol=1e-3, max_iter=60))
+        self.mask_rule_ = self.mask_rule or MaskRule()
+
+    def configure(self, **params):
+        """
+        Change parameters while running, keeping the buffered frames.
+
+        The whole change is validated first; on ``ValueError`` nothing changes.
+        A new ``window`` keeps the newest frames; a new ``scale`` resamples the
+        buffered frames and drops the background model until the next solve,
+        which is then due at once; a new ``color`` restarts the window (grey
+        frames cannot become colour); model and mask parameters take effect at
+        the next solve.
+        """
+        unknown = set(params) - set(self.__init__.__code__.co_varnames[1:])
+        if unknown:
+            raise ValueError(f'unknown parameters: {", ".join(sorted(unknown))}')
+        old = {name: getattr(self, name) for name in params}
+        for name, value in params.items():
+            setattr(self, name, value)
+        try:
+            self.validate()
+        except ValueError:
+            for name, value in old.items():
+                setattr(self, name, value)
+            raise
+        if not hasattr(self, 'buffer_'):
+            return self
+        self._build_helpers()
+        if 'color' in params and params['color'] != old['color']:
+            self.reset()
+            return self
+        if self.buffer_.maxlen != int(self.window):
+            self.buffer_ = deque(self.buffer_, maxlen=int(self.window))
+            self.ids_ = deque(self.ids_, maxlen=int(self.window))
+        if ('scale' in params and params['scale'] != old['scale']
+                and self.input_shape_ is not None):
+            rows, cols = processing_shape(self.input_shape_, self.scale)
+            channels = self.shape_[2]
+            old_rows, old_cols = self.shape_[:2]
+            resampled = deque(maxlen=int(self.window))
+            for columns in self.buffer_:
+                image = columns.T.reshape(old_rows, old_cols, channels)
+                image = resize(image, (rows, cols)).reshape(rows * cols, channels)
+                resampled.append(np.ascontiguousarray(image.T))
+            self.buffer_ = resampled
+            self.shape_ = (rows, cols, channels)
+            self.background_model_ = None
+        return self
 
     def reset(self):
         """Forget every buffered frame and the background model."""
@@ -247,8 +301,14 @@ class SlidingWindowDetector:
         result = self._buffer(columns, shape, input_shape)
         solved = None
         if self.solve_due():
-            solved = self.solve(self.snapshot())
-            self.install(solved)
+            try:
+                solved = self.solve(self.snapshot())
+            except SolverFailure as error:
+                # Keep the previous model; the next solve starts cold.
+                result.solve_error = str(error)
+                self.drop_warm_start()
+            else:
+                self.install(solved)
         return self._masked(result, columns), solved
 
     def _buffer(self, columns, shape, input_shape):
@@ -308,11 +368,16 @@ class SlidingWindowDetector:
         data = np.stack(self.buffer_, axis=2)                 # (C, n, m)
         self.since_solve_ = 0
         return WindowSnapshot(data=data, shape=self.shape_, first_id=self.ids_[0],
-                              last_id=self.ids_[-1], previous=self.background_model_)
+                              last_id=self.ids_[-1], previous=self.background_model_,
+                              model=self.model_, mask_rule=self.mask_rule_)
 
     def solve(self, snapshot):
         """
-        Separate a snapshot into a :class:`BackgroundModel` (thread-safe).
+        Separate a snapshot into a :class:`BackgroundModel`.
+
+        Reads nothing but the snapshot, so it may run in another thread while
+        frames are pushed (the estimator in the snapshot must not be shared
+        with another concurrent solve).
 
         Raises
         ------
@@ -340,7 +405,7 @@ class SlidingWindowDetector:
                 state = previous.states[channel]
                 init = state.shifted(shift, state.background[:, -1])
             try:
-                fitted = self.model_.fit(data, (rows, cols), init=init)
+                fitted = snapshot.model.fit(data, (rows, cols), init=init)
             except (ValueError, FloatingPointError, np.linalg.LinAlgError) as error:
                 raise SolverFailure(f'window solve failed: {error}') from error
             background = np.asarray(fitted.background_, dtype=np.float32)
@@ -361,10 +426,15 @@ class SlidingWindowDetector:
             basis=basis,
             background=np.stack(backgrounds, axis=1).reshape(rows, cols, channels),
             mean_background=np.stack(means, axis=1).reshape(rows, cols, channels),
-            threshold=self.mask_rule_.estimate_threshold(np.stack(residuals)),
+            threshold=snapshot.mask_rule.estimate_threshold(np.stack(residuals)),
             shape=snapshot.shape, first_id=snapshot.first_id, last_id=snapshot.last_id,
             states=states, seconds=time.perf_counter() - started,
             iterations=iterations, info=info)
+
+    def drop_warm_start(self):
+        """Make the next solve start cold (after a failed one), keeping the fast path."""
+        if self.background_model_ is not None:
+            self.background_model_.states = []
 
     def install(self, model):
         """Make ``model`` the fast path's background; ignore it if the stream moved on."""

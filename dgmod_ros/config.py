@@ -1,0 +1,197 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""
+Every tunable parameter in one table, shared by the node and the command line.
+
+The node declares a ROS parameter for each entry (with its description and
+range), the command line offers each as an option and reads the node's YAML
+parameter file, and :func:`build_detector` turns a full set of values into core
+objects. No ROS import here.
+"""
+
+from dataclasses import dataclass
+
+import yaml
+
+from .core.dgmod import DualGraphMOD
+from .core.masks import MaskRule
+from .core.subtractors import OpenCVSubtractor
+from .core.window import SlidingWindowDetector
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One parameter: name, default, description and the range ROS enforces."""
+
+    name: str
+    default: object
+    description: str
+    low: object = None
+    high: object = None
+    step: int = 1
+    choices: tuple = ()
+    read_only: bool = False
+
+
+PARAMETERS = (
+    # Method and window.
+    Parameter('method', 'dgmod', 'separation method: dgmod (the dual-graph model), or OpenCV '
+              'mog2 / knn run per frame in its place', choices=('dgmod', 'mog2', 'knn')),
+    Parameter('window', 30, 'frames m in the sliding window', 2, 300),
+    Parameter('stride', 10, 'buffered frames between window solves (<= window)', 1, 300),
+    Parameter('scale', 0.5, 'processing scale of frames; masks come back at input size',
+              0.05, 1.0),
+    Parameter('color', 'gray', 'gray: one luma channel; rgb: each channel solved, fused by '
+              'the largest magnitude', choices=('gray', 'rgb')),
+    Parameter('min_frames', 5, 'frames before the first solve (<= window); until then masks '
+              'use the per-pixel median of the buffer', 2, 300),
+    Parameter('basis_rank', 2, 'background components the per-frame fast path projects on',
+              1, 20),
+    Parameter('motion_threshold', 0.0, 'frames whose mean absolute change to the last '
+              'buffered frame is below this are masked but not buffered; 0 buffers all',
+              0.0, 1.0),
+    Parameter('value_range', 0.0, 'pixel value meaning full scale (for example 5000.0 for '
+              '16UC1 depth in mm); 0 uses the type range (floats: 1.0)', 0.0, 1e9),
+    # Model (Algorithm 1).
+    Parameter('lambda1', 0.0, 'weight of the weighted nuclear norm; 0 = lambda2 * '
+              'sqrt(max(n, m))', 0.0, 1e6),
+    Parameter('lambda2', 0.5, 'weight of ||S||_1; below 1 so that S takes the foreground',
+              1e-6, 0.999),
+    Parameter('gamma1', 0.5, 'weight of the spatial graph term', 0.0, 1e3),
+    Parameter('gamma2', 0.5, 'weight of the temporal graph term', 0.0, 1e3),
+    Parameter('rho1', 20.0, 'ADMM penalty of U = L', 1e-3, 1e6),
+    Parameter('rho2', 20.0, 'ADMM penalty of V = D - L - S', 1e-3, 1e6),
+    Parameter('weight_scale', 0.0, 'scale s of the weights exp(-sigma^2/s^2); 0 = 0.1 * '
+              'largest singular value of the window', 0.0, 1e9),
+    Parameter('h_s', 0.0, 'spatial filtering parameter; 0 = median patch distance', 0.0, 1e9),
+    Parameter('h_t', 0.0, 'temporal filtering parameter; 0 = median frame distance',
+              0.0, 1e9),
+    Parameter('patch_size', 3, 'odd side p of the patches of the spatial graph', 1, 15, 2),
+    Parameter('smoothing_sigma', 0.0, 'Gaussian pre-smoothing (pixels) before patch '
+              'distances; 0 = off', 0.0, 10.0),
+    Parameter('temporal_neighbors', 4, 'frames joined to each frame in the temporal graph',
+              2, 20),
+    Parameter('l_step', 'gradient', 'L-step: gradient (paper) or exact (block CG in the '
+              'temporal eigenbasis)', choices=('gradient', 'exact')),
+    Parameter('inner_iter', 1, 'gradient steps or CG iterations per L-step (T_in)', 1, 50),
+    Parameter('tol', 1e-3, 'stop when relative changes and residuals are below this',
+              1e-8, 0.1),
+    Parameter('max_iter', 60, 'ADMM sweeps per window solve at most (T_out)', 1, 10000),
+    # Masks.
+    Parameter('mask_threshold', 0.0, 'fixed threshold on |S| for data in [0, 1]; 0 = auto '
+              '(max(mask_min_threshold, mask_k * robust sigma of D - L))', 0.0, 1.0),
+    Parameter('mask_k', 5.0, 'multiple of the robust noise level of the auto threshold',
+              0.1, 100.0),
+    Parameter('mask_min_threshold', 0.1, 'floor of the auto threshold', 0.0, 1.0),
+    Parameter('morph_size', 3, 'kernel of the morphological opening and closing; 0 = off',
+              0, 15),
+    # Node only.
+    Parameter('solve_mode', 'async', 'async: solves run in a worker thread while frames are '
+              'masked; sync: in the image callback (deterministic, for replays)',
+              choices=('async', 'sync')),
+    Parameter('max_pixels', 4096 * 4096, 'refuse images with more pixels than this',
+              1, 1 << 30),
+    Parameter('publish_overlay', False, 'publish foreground_overlay (rgb8) for rviz'),
+    Parameter('diagnostics_period', 1.0, 'seconds between /diagnostics messages', 0.1, 60.0),
+)
+
+BY_NAME = {p.name: p for p in PARAMETERS}
+DEFAULTS = {p.name: p.default for p in PARAMETERS}
+
+
+def _auto(value):
+    """Map the ROS-friendly 0.0 for 'automatic' to None."""
+    return None if value == 0 else value
+
+
+def check_value(name, value):
+    """Raise ``ValueError`` when ``value`` is outside ``name``'s choices or range."""
+    spec = BY_NAME[name]
+    if spec.choices and value not in spec.choices:
+        raise ValueError(f'{name} must be one of {", ".join(spec.choices)}, got {value!r}')
+    if spec.low is not None and not spec.low <= value <= spec.high:
+        raise ValueError(f'{name} must be in [{spec.low}, {spec.high}], got {value!r}')
+
+
+def build_model(values):
+    """Return the :class:`DualGraphMOD` the values describe."""
+    return DualGraphMOD(
+        lambda1=_auto(values['lambda1']), lambda2=values['lambda2'],
+        gamma1=values['gamma1'], gamma2=values['gamma2'], rho1=values['rho1'],
+        rho2=values['rho2'], weight_scale=_auto(values['weight_scale']),
+        h_s=_auto(values['h_s']), h_t=_auto(values['h_t']), patch_size=values['patch_size'],
+        smoothing_sigma=values['smoothing_sigma'],
+        temporal_neighbors=values['temporal_neighbors'], l_step=values['l_step'],
+        inner_iter=values['inner_iter'], tol=values['tol'], max_iter=values['max_iter'])
+
+
+def build_mask_rule(values):
+    """Return the :class:`MaskRule` the values describe."""
+    threshold = values['mask_threshold'] if values['mask_threshold'] > 0 else 'auto'
+    return MaskRule(threshold=threshold, k=values['mask_k'],
+                    min_threshold=values['mask_min_threshold'], morph_size=values['morph_size'])
+
+
+def detector_settings(values):
+    """Return the keyword arguments of the streaming detector the values describe."""
+    if values['method'] != 'dgmod':
+        return {'kind': values['method'], 'scale': values['scale'], 'color': values['color'],
+                'morph_size': values['morph_size']}
+    return {'model': build_model(values), 'window': values['window'],
+            'stride': values['stride'], 'scale': values['scale'], 'color': values['color'],
+            'mask_rule': build_mask_rule(values),
+            'motion_threshold': values['motion_threshold'],
+            'min_frames': values['min_frames'], 'basis_rank': values['basis_rank']}
+
+
+def validate(values):
+    """
+    Check a complete set of values, ranges and cross-field rules alike.
+
+    Returns the values; raises ``ValueError`` with the first problem found.
+    """
+    missing = set(DEFAULTS) - set(values)
+    if missing:
+        raise ValueError(f'missing parameters: {", ".join(sorted(missing))}')
+    for name, value in values.items():
+        if name not in BY_NAME:
+            raise ValueError(f'unknown parameter {name!r}')
+        check_value(name, value)
+    settings = detector_settings(values)
+    if values['method'] == 'dgmod':
+        SlidingWindowDetector(**settings).validate()
+        settings['model'].check_parameters()
+    else:
+        OpenCVSubtractor(**settings).validate()
+    return values
+
+
+def build_detector(values):
+    """Return a validated streaming detector for a complete set of values."""
+    validate(values)
+    settings = detector_settings(values)
+    if values['method'] == 'dgmod':
+        return SlidingWindowDetector(**settings).validate()
+    return OpenCVSubtractor(**settings).validate()
+
+
+def load_parameter_file(path):
+    """
+    Read the ``ros__parameters`` of a ROS parameter YAML file.
+
+    Accepts the node's own layout (``/detector: ros__parameters: ...``), any
+    node name (``/**`` included), or a flat mapping. Unknown keys are refused.
+    """
+    with open(path, encoding='utf-8') as handle:
+        content = yaml.safe_load(handle) or {}
+    if not isinstance(content, dict):
+        raise ValueError(f'{path}: expected a mapping at the top level')
+    params = content
+    for value in content.values():
+        if isinstance(value, dict) and 'ros__parameters' in value:
+            params = value['ros__parameters'] or {}
+            break
+    unknown = set(params) - set(DEFAULTS)
+    if unknown:
+        raise ValueError(f'{path}: unknown parameters: {", ".join(sorted(unknown))}')
+    return dict(params)

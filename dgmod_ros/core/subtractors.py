@@ -1,0 +1,130 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""OpenCV's per-frame subtractors behind the streaming detector's interface."""
+
+import cv2
+import numpy as np
+
+from .preprocess import processing_shape, resize, to_float_channels
+from .window import FrameResult
+
+_FACTORIES = {
+    'mog2': cv2.createBackgroundSubtractorMOG2,
+    'knn': cv2.createBackgroundSubtractorKNN,
+}
+
+
+class OpenCVSubtractor:
+    """
+    OpenCV MOG2 or KNN with default settings, as a ROS user would run it.
+
+    Same interface as :class:`~dgmod_ros.core.window.SlidingWindowDetector`
+    (``push``, ``process``, ``solve_due`` is always False), so the node and
+    the command line can run it in the dual-graph model's place. Its output is
+    already a mask: 255 is foreground, 127 (a shadow) is not. The mask is
+    resized to the input size and cleaned with the same morphology as
+    :class:`~dgmod_ros.core.masks.MaskRule`.
+
+    Parameters
+    ----------
+    kind : {'mog2', 'knn'}, default='mog2'
+        Which subtractor.
+    scale : float, default=0.5
+        Processing scale.
+    color : {'gray', 'rgb'}, default='gray'
+        Feed luma or the three colour channels.
+    morph_size : int, default=3
+        Opening and closing kernel; 0 or 1 disables it.
+
+    References
+    ----------
+    .. [1] Z. Zivkovic, "Improved adaptive Gaussian mixture model for background
+       subtraction", ICPR 2004.
+    .. [2] Z. Zivkovic, F. van der Heijden, "Efficient adaptive density
+       estimation per image pixel for the task of background subtraction",
+       Pattern Recognition Letters 27(7), 2006.
+
+    """
+
+    def __init__(self, kind='mog2', scale=0.5, color='gray', morph_size=3):
+        self.kind = kind
+        self.scale = scale
+        self.color = color
+        self.morph_size = morph_size
+
+    def validate(self):
+        """Check the parameters; raise ``ValueError`` naming the bad one."""
+        if self.kind not in _FACTORIES:
+            raise ValueError(f"kind must be 'mog2' or 'knn', got {self.kind!r}")
+        if not (isinstance(self.scale, (int, float)) and 0 < self.scale <= 1):
+            raise ValueError(f'scale must be in (0, 1], got {self.scale!r}')
+        if self.color not in ('gray', 'rgb'):
+            raise ValueError(f"color must be 'gray' or 'rgb', got {self.color!r}")
+        if int(self.morph_size) != self.morph_size or self.morph_size < 0:
+            raise ValueError(f'morph_size must be a non-negative integer, got {self.morph_size!r}')
+        return self
+
+    def reset(self):
+        """Start a new background model."""
+        self.subtractor_ = _FACTORIES[self.kind]()
+        self.input_shape_ = None
+        self.next_id_ = 0
+        self.background_model_ = None
+
+    def configure(self, **params):
+        """Change parameters (validated first); the background model restarts."""
+        old = {name: getattr(self, name) for name in params}
+        for name, value in params.items():
+            setattr(self, name, value)
+        try:
+            self.validate()
+        except ValueError:
+            for name, value in old.items():
+                setattr(self, name, value)
+            raise
+        self.reset()
+        return self
+
+    def push(self, frame, channel_order='rgb', value_range=None):
+        """Mask one frame; see :meth:`SlidingWindowDetector.push`."""
+        if not hasattr(self, 'subtractor_'):
+            self.validate().reset()
+        frame = np.asarray(frame)
+        if frame.ndim < 2 or frame.shape[0] == 0 or frame.shape[1] == 0:
+            raise ValueError(f'frame must be a non-empty image, got shape {frame.shape}')
+        channels = to_float_channels(frame, channel_order, self.color, value_range)
+        reset = self.input_shape_ is not None and frame.shape[:2] != self.input_shape_
+        if reset:
+            self.reset()
+        self.input_shape_ = frame.shape[:2]
+        small = resize(channels, processing_shape(frame.shape[:2], self.scale))
+        image = np.clip(small * 255.0 + 0.5, 0, 255).astype(np.uint8)
+        if image.ndim == 3 and image.shape[2] == 3:
+            image = cv2.cvtColor(image, cv2.COLOR_RGB2BGR)
+        raw = self.subtractor_.apply(image)
+        mask = np.where(raw == 255, np.uint8(255), np.uint8(0))
+        if mask.shape != self.input_shape_:
+            mask = cv2.resize(mask, self.input_shape_[::-1], interpolation=cv2.INTER_NEAREST)
+        if self.morph_size > 1:
+            kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE,
+                                               (self.morph_size, self.morph_size))
+            mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, kernel)
+            mask = cv2.morphologyEx(mask, cv2.MORPH_CLOSE, kernel)
+        frame_id = self.next_id_
+        self.next_id_ += 1
+        return FrameResult(mask=mask, magnitude=raw.astype(np.float32) / 255.0,
+                           frame_id=frame_id, buffered=False, reset=reset, model_ready=True)
+
+    def process(self, frame, channel_order='rgb', value_range=None):
+        """Mask one frame; there is never a window solve."""
+        return self.push(frame, channel_order, value_range), None
+
+    def solve_due(self):
+        """Return False: the subtractor updates its model with every frame."""
+        return False
+
+    def background_image(self):
+        """Return OpenCV's background image as floats in [0, 1] (rows, cols, C)."""
+        image = self.subtractor_.getBackgroundImage()
+        image = image.astype(np.float32) / 255.0
+        return image[:, :, None] if image.ndim == 2 else image[:, :, ::-1]

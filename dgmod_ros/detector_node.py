@@ -1,0 +1,283 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""
+The ``detector`` node: a foreground mask for every camera frame.
+
+Subscribes ``image`` (sensor_msgs/Image, sensor-data QoS) and publishes
+``foreground_mask`` (mono8, 0/255, the frame's size and header),
+``background`` (mono8 or rgb8 at the input size, the newest frame's header,
+after every window solve), optionally ``foreground_overlay`` (rgb8), and
+``/diagnostics``. All numerical work is in :mod:`dgmod_ros.core`; this module
+converts messages, holds parameters and schedules solves.
+"""
+
+import threading
+import time
+
+import cv2
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+import numpy as np
+from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
+                                SetParametersResult)
+import rclpy
+from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
+from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.node import Node
+from rclpy.qos import QoSProfile, qos_profile_sensor_data
+from rclpy.qos_overriding_options import QoSOverridingOptions
+from sensor_msgs.msg import Image
+
+from . import config
+from .core.preprocess import to_float_channels
+from .core.window import SolverFailure
+from .image_conversion import array_to_image_fields, ImageConversionError, image_to_array
+from .solve_worker import SolveWorker
+from .stats import DetectorStats
+
+# Seconds between repeats of one kind of warning.
+_WARN_PERIOD = 5.0
+
+
+def _descriptor(spec):
+    descriptor = ParameterDescriptor(description=spec.description, read_only=spec.read_only)
+    if spec.choices:
+        descriptor.additional_constraints = 'one of: ' + ', '.join(spec.choices)
+    elif isinstance(spec.default, bool):
+        pass
+    elif isinstance(spec.default, int):
+        descriptor.integer_range = [IntegerRange(from_value=spec.low, to_value=spec.high,
+                                                 step=spec.step)]
+    elif isinstance(spec.default, float):
+        descriptor.floating_point_range = [FloatingPointRange(
+            from_value=float(spec.low), to_value=float(spec.high), step=0.0)]
+    return descriptor
+
+
+def _message(fields, header):
+    msg = Image()
+    msg.header = header
+    for name, value in fields.items():
+        setattr(msg, name, value)
+    return msg
+
+
+class DetectorNode(Node):
+    """ROS wiring around :mod:`dgmod_ros.core`'s streaming detector."""
+
+    def __init__(self, **kwargs):
+        super().__init__('detector', **kwargs)
+        for spec in config.PARAMETERS:
+            self.declare_parameter(spec.name, spec.default, _descriptor(spec))
+        self._values = {spec.name: self.get_parameter(spec.name).value
+                        for spec in config.PARAMETERS}
+        config.validate(self._values)       # a bad parameter file stops the node here
+        self._detector = config.build_detector(self._values)
+        self._lock = threading.Lock()       # guards the detector between callbacks
+        self._stats = DetectorStats()
+        self._last_header = None
+        self._worker = SolveWorker(self._solve, self._on_solved, self._on_solve_error)
+
+        images = MutuallyExclusiveCallbackGroup()
+        timers = MutuallyExclusiveCallbackGroup()
+        self._subscription = self.create_subscription(
+            Image, 'image', self._on_image, qos_profile_sensor_data, callback_group=images,
+            qos_overriding_options=QoSOverridingOptions.with_default_policies())
+        outputs = QoSProfile(depth=5)
+        self._mask_pub = self.create_publisher(Image, 'foreground_mask', outputs)
+        self._background_pub = self.create_publisher(Image, 'background', outputs)
+        self._overlay_pub = None
+        self._diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 1)
+        self._timer_group = timers
+        self._diagnostics_timer = None
+        self._apply_node_parameters()
+        self.add_on_set_parameters_callback(self._check_parameters)
+        self.add_post_set_parameters_callback(self._apply_parameters)
+        self.get_logger().info(
+            f"detector ready: method {self._values['method']}, window "
+            f"{self._values['window']}, stride {self._values['stride']}, scale "
+            f"{self._values['scale']}, solve_mode {self._values['solve_mode']}")
+
+    # ----------------------------------------------------------------- frames
+    def _on_image(self, msg):
+        received = time.monotonic()
+        self._stats.received()
+        try:
+            image, order = image_to_array(msg, self._values['max_pixels'])
+        except ImageConversionError as error:
+            self._stats.drop(error.reason)
+            self.get_logger().warning(f'dropped a frame: {error}',
+                                      throttle_duration_sec=_WARN_PERIOD)
+            return
+        value_range = self._values['value_range'] or None
+        with self._lock:
+            self._last_header = msg.header
+            try:
+                if self._values['solve_mode'] == 'sync':
+                    result, solved = self._detector.process(image, order or 'rgb', value_range)
+                else:
+                    result, solved = self._detector.push(image, order or 'rgb', value_range), None
+                    if self._detector.solve_due() and not self._worker.busy:
+                        self._worker.submit(self._detector.snapshot())
+            except ValueError as error:
+                self._stats.drop('invalid')
+                self.get_logger().warning(f'dropped a frame: {error}',
+                                          throttle_duration_sec=_WARN_PERIOD)
+                return
+        self._mask_pub.publish(_message(array_to_image_fields(result.mask, 'mono8'),
+                                        msg.header))
+        self._stats.masked(time.monotonic() - received)
+        if result.reset:
+            self._stats.window_reset()
+            self.get_logger().info(f'frame size or encoding changed to {msg.width} x '
+                                   f'{msg.height} {msg.encoding}: window restarted')
+        if result.solve_error:
+            self._on_solve_error(None, SolverFailure(result.solve_error))
+        if solved is not None:
+            self._stats.solved(solved.seconds, solved.iterations, solved.info)
+            self._publish_background(solved, msg.header)
+        elif self._values['method'] != 'dgmod' and result.frame_id % self._values['stride'] == 0:
+            self._publish_opencv_background(msg.header)
+        if self._overlay_pub is not None:
+            self._publish_overlay(image, order, value_range, result.mask, msg.header)
+
+    # ----------------------------------------------------------------- solves
+    def _solve(self, snapshot):
+        return self._detector.solve(snapshot)
+
+    def _on_solved(self, snapshot, model):
+        with self._lock:
+            installed = self._detector.install(model)
+            header = self._last_header
+        if installed:
+            self._stats.solved(model.seconds, model.iterations, model.info)
+            self._publish_background(model, header)
+
+    def _on_solve_error(self, snapshot, error):
+        self._stats.failed(str(error))
+        if snapshot is not None:
+            with self._lock:
+                self._detector.drop_warm_start()
+        self.get_logger().warning(f'window solve failed, previous background kept: {error}',
+                                  throttle_duration_sec=_WARN_PERIOD)
+
+    def _publish_background(self, model, header):
+        if header is None:
+            return
+        input_shape = self._detector.input_shape_
+        image = cv2.resize(model.background, (input_shape[1], input_shape[0]),
+                           interpolation=cv2.INTER_LINEAR)
+        self._publish_background_image(image, header)
+
+    def _publish_opencv_background(self, header):
+        self._publish_background_image(cv2.resize(
+            self._detector.background_image(), self._detector.input_shape_[::-1]), header)
+
+    def _publish_background_image(self, image, header):
+        pixels = np.clip(np.asarray(image) * 255.0 + 0.5, 0, 255).astype(np.uint8)
+        if pixels.ndim == 3 and pixels.shape[2] == 1:
+            pixels = pixels[:, :, 0]
+        encoding = 'mono8' if pixels.ndim == 2 else 'rgb8'
+        self._background_pub.publish(_message(array_to_image_fields(pixels, encoding), header))
+
+    def _publish_overlay(self, image, order, value_range, mask, header):
+        rgb = to_float_channels(image, order or 'rgb', 'rgb', value_range)
+        tinted = rgb * 255.0
+        tinted[mask > 0] = 0.5 * tinted[mask > 0] + np.array([127.5, 0.0, 0.0])
+        pixels = np.clip(tinted + 0.5, 0, 255).astype(np.uint8)
+        self._overlay_pub.publish(_message(array_to_image_fields(pixels, 'rgb8'), header))
+
+    # ----------------------------------------------------------------- parameters
+    def _check_parameters(self, parameters):
+        candidate = dict(self._values)
+        candidate.update({p.name: p.value for p in parameters})
+        try:
+            config.validate(candidate)
+        except ValueError as error:
+            return SetParametersResult(successful=False, reason=str(error))
+        return SetParametersResult(successful=True)
+
+    def _apply_parameters(self, parameters):
+        changed = {p.name: p.value for p in parameters}
+        values = dict(self._values)
+        values.update(changed)
+        with self._lock:
+            if values['method'] != self._values['method']:
+                self._detector = config.build_detector(values)
+            else:
+                self._detector.configure(**config.detector_settings(values))
+            self._values = values
+        self._apply_node_parameters()
+        self.get_logger().info('parameters changed: ' + ', '.join(
+            f'{name}={value}' for name, value in sorted(changed.items())))
+
+    def _apply_node_parameters(self):
+        if self._values['publish_overlay'] and self._overlay_pub is None:
+            self._overlay_pub = self.create_publisher(Image, 'foreground_overlay',
+                                                      QoSProfile(depth=5))
+        elif not self._values['publish_overlay'] and self._overlay_pub is not None:
+            self.destroy_publisher(self._overlay_pub)
+            self._overlay_pub = None
+        period = self._values['diagnostics_period']
+        if self._diagnostics_timer is None or \
+                abs(self._diagnostics_timer.timer_period_ns - period * 1e9) > 1:
+            if self._diagnostics_timer is not None:
+                self.destroy_timer(self._diagnostics_timer)
+            self._diagnostics_timer = self.create_timer(period, self._publish_diagnostics,
+                                                        callback_group=self._timer_group)
+
+    # ----------------------------------------------------------------- diagnostics
+    def statistics(self):
+        """Return the node's counters and figures as a dict."""
+        figures = self._stats.snapshot()
+        with self._lock:
+            buffer = getattr(self._detector, 'buffer_', ())
+            figures['window_frames'] = len(buffer)
+            figures['model_ready'] = getattr(self._detector, 'background_model_',
+                                             None) is not None
+        return figures
+
+    def _publish_diagnostics(self):
+        figures = self.statistics()
+        status = DiagnosticStatus(name=f'{self.get_name()}: foreground detection',
+                                  hardware_id=self.get_fully_qualified_name())
+        problems = []
+        if figures['frames_dropped']:
+            problems.append(f"{figures['frames_dropped']} frames dropped")
+        if figures['solve_failures']:
+            problems.append(f"{figures['solve_failures']} solves failed")
+        if not figures['model_ready'] and self._values['method'] == 'dgmod':
+            problems.append('warming up: no window solved yet')
+        status.level = DiagnosticStatus.WARN if problems else DiagnosticStatus.OK
+        status.message = '; '.join(problems) or 'masks published for every frame'
+        status.values = [KeyValue(key=key, value=str(value)) for key, value in figures.items()]
+        array = DiagnosticArray(status=[status])
+        array.header.stamp = self.get_clock().now().to_msg()
+        self._diagnostics_pub.publish(array)
+
+    def destroy_node(self):
+        """Stop the solver thread, then the node."""
+        self._worker.stop(timeout=1.0)
+        return super().destroy_node()
+
+
+def main(args=None):
+    """Run the detector until Ctrl-C, SIGTERM or an external shutdown."""
+    # Jazzy's rclpy.init() returns None (the context-manager form arrived after
+    # Jazzy), so the context is shut down in a finally block instead.
+    rclpy.init(args=args)
+    node = None
+    try:
+        node = DetectorNode()
+        executor = MultiThreadedExecutor(num_threads=2)
+        executor.add_node(node)
+        executor.spin()
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+
+
+if __name__ == '__main__':
+    main()

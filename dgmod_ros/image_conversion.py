@@ -1,0 +1,119 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""
+``sensor_msgs/Image`` <-> numpy without cv_bridge and without importing ROS.
+
+Works on any object with the message's fields (``height``, ``width``,
+``encoding``, ``is_bigendian``, ``step``, ``data``), so it is tested without
+ROS. Rows are read through ``step`` (padding honoured) and multi-byte pixels
+in the byte order ``is_bigendian`` states, as cv_bridge's ``imgmsg_to_cv2``
+does; numpy 2 has no ``ndarray.newbyteorder``, so the dtype carries the order.
+"""
+
+import numpy as np
+
+#: encoding -> (numpy dtype, channels, channel order of colour images)
+ENCODINGS = {
+    'mono8': (np.uint8, 1, None),
+    '8UC1': (np.uint8, 1, None),
+    'mono16': (np.uint16, 1, None),
+    '16UC1': (np.uint16, 1, None),
+    '32FC1': (np.float32, 1, None),
+    'rgb8': (np.uint8, 3, 'rgb'),
+    'bgr8': (np.uint8, 3, 'bgr'),
+    'rgba8': (np.uint8, 4, 'rgb'),
+    'bgra8': (np.uint8, 4, 'bgr'),
+}
+
+
+class ImageConversionError(ValueError):
+    """
+    A message that cannot be turned into an image.
+
+    ``reason`` is a short stable key for counters (``'encoding'``, ``'size'``,
+    ``'step'``, ``'data_length'``, ``'too_large'``, ``'non_finite'``).
+    """
+
+    def __init__(self, reason, message):
+        super().__init__(message)
+        self.reason = reason
+
+
+def image_to_array(msg, max_pixels=None):
+    """
+    Return the pixels of an Image message as a new ``(h, w)`` or ``(h, w, c)`` array.
+
+    Parameters
+    ----------
+    msg : sensor_msgs.msg.Image or any object with its fields
+        The message; its buffer is copied, never aliased.
+    max_pixels : int or None
+        Refuse images with more pixels than this.
+
+    Returns
+    -------
+    image : ndarray
+        Native byte order.
+    channel_order : {'rgb', 'bgr'} or None
+        For colour encodings.
+
+    Raises
+    ------
+    ImageConversionError
+        With a ``reason`` key and a sentence naming the problem.
+
+    """
+    encoding = msg.encoding
+    if encoding not in ENCODINGS:
+        raise ImageConversionError(
+            'encoding', f'unsupported encoding {encoding!r} (supported: '
+                        f'{", ".join(sorted(ENCODINGS))})')
+    base, channels, order = ENCODINGS[encoding]
+    height, width, step = int(msg.height), int(msg.width), int(msg.step)
+    if height <= 0 or width <= 0:
+        raise ImageConversionError('size', f'empty image: {width} x {height}')
+    if max_pixels is not None and height * width > max_pixels:
+        raise ImageConversionError(
+            'too_large', f'{width} x {height} = {width * height} pixels exceeds the limit '
+                         f'of {max_pixels}')
+    dtype = np.dtype(base).newbyteorder('>' if msg.is_bigendian else '<')
+    row_bytes = width * channels * dtype.itemsize
+    if step < row_bytes:
+        raise ImageConversionError(
+            'step', f'step {step} is smaller than one row of {width} {encoding} pixels '
+                    f'({row_bytes} bytes)')
+    data = msg.data
+    size = len(data)
+    if size != step * height:
+        raise ImageConversionError(
+            'data_length', f'data holds {size} bytes, step x height = {step * height}')
+    try:
+        raw = np.frombuffer(data, dtype=np.uint8)     # bytes, array.array('B'), memoryview
+    except TypeError:
+        raw = np.asarray(data, dtype=np.uint8)        # a plain list of ints
+    rows = raw.reshape(height, step)[:, :row_bytes]
+    image = np.ascontiguousarray(rows).view(dtype).reshape(height, width, channels)
+    image = image.astype(dtype.newbyteorder('='), copy=True)
+    if channels == 1:
+        image = image[:, :, 0]
+    if image.dtype.kind == 'f' and not np.all(np.isfinite(image)):
+        raise ImageConversionError('non_finite', f'{encoding} image contains NaN or Inf')
+    return image, order
+
+
+def array_to_image_fields(image, encoding):
+    """
+    Return the ``height, width, encoding, is_bigendian, step, data`` of an Image.
+
+    ``image`` must already have the dtype and channel count of ``encoding``.
+    """
+    base, channels, _ = ENCODINGS[encoding]
+    image = np.ascontiguousarray(image, dtype=np.dtype(base).newbyteorder('='))
+    if image.ndim == 2:
+        image = image[:, :, None]
+    if image.shape[2] != channels:
+        raise ValueError(f'{encoding} needs {channels} channels, got {image.shape[2]}')
+    height, width = image.shape[:2]
+    return {'height': height, 'width': width, 'encoding': encoding,
+            'is_bigendian': int(not np.little_endian),
+            'step': width * channels * image.dtype.itemsize, 'data': image.tobytes()}

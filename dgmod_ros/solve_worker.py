@@ -1,0 +1,74 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""A single background thread that runs one window solve at a time (no ROS import)."""
+
+import threading
+
+
+class SolveWorker:
+    """
+    Run ``solve(job)`` in one daemon thread, at most one job at a time.
+
+    There is no queue: :meth:`submit` refuses a job while another runs, so a
+    burst of frames can never pile up solves; the caller simply submits the
+    next snapshot when the next solve is due. ``on_done(job, result)`` or
+    ``on_error(job, exception)`` run in the worker thread.
+    """
+
+    def __init__(self, solve, on_done, on_error, name='dgmod-solver'):
+        self._solve = solve
+        self._on_done = on_done
+        self._on_error = on_error
+        self._condition = threading.Condition()
+        self._job = None
+        self._busy = False
+        self._stopping = False
+        self._thread = threading.Thread(target=self._run, name=name, daemon=True)
+        self._thread.start()
+
+    @property
+    def busy(self):
+        """Tell whether a job is queued or running."""
+        with self._condition:
+            return self._busy
+
+    def submit(self, job):
+        """Hand over a job; return False (and drop it) if one is already in hand."""
+        with self._condition:
+            if self._busy or self._stopping:
+                return False
+            self._job = job
+            self._busy = True
+            self._condition.notify()
+            return True
+
+    def wait_idle(self, timeout=None):
+        """Block until no job is in hand; return False on timeout."""
+        with self._condition:
+            return self._condition.wait_for(lambda: not self._busy, timeout)
+
+    def stop(self, timeout=1.0):
+        """Ask the thread to finish after the current job and join it."""
+        with self._condition:
+            self._stopping = True
+            self._condition.notify_all()
+        self._thread.join(timeout)
+        return not self._thread.is_alive()
+
+    def _run(self):
+        while True:
+            with self._condition:
+                self._condition.wait_for(lambda: self._job is not None or self._stopping)
+                if self._stopping:
+                    return
+                job, self._job = self._job, None
+            try:
+                result = self._solve(job)
+            except Exception as error:  # noqa: B902 - reported, never kills the thread
+                self._on_error(job, error)
+            else:
+                self._on_done(job, result)
+            finally:
+                with self._condition:
+                    self._busy = False
+                    self._condition.notify_all()
