@@ -13,9 +13,10 @@ from dataclasses import dataclass
 
 import yaml
 
+from .core.baselines.median import TemporalMedian
 from .core.dgmod import DualGraphMOD
 from .core.masks import MaskRule
-from .core.subtractors import OpenCVSubtractor
+from .core.subtractors import OpenCVSubtractor, OpenCVWindowModel
 from .core.window import SlidingWindowDetector
 
 
@@ -35,8 +36,9 @@ class Parameter:
 
 PARAMETERS = (
     # Method and window.
-    Parameter('method', 'dgmod', 'separation method: dgmod (the dual-graph model), or OpenCV '
-              'mog2 / knn run per frame in its place', choices=('dgmod', 'mog2', 'knn')),
+    Parameter('method', 'dgmod', 'separation method: dgmod (the dual-graph model); median '
+              '(sliding temporal median); OpenCV mog2 / knn run per frame in its place',
+              choices=('dgmod', 'median', 'mog2', 'knn')),
     Parameter('window', 30, 'frames m in the sliding window', 2, 300),
     Parameter('stride', 10, 'buffered frames between window solves (<= window)', 1, 300),
     Parameter('scale', 0.5, 'processing scale of frames; masks come back at input size',
@@ -132,12 +134,28 @@ def build_mask_rule(values):
                     min_threshold=values['mask_min_threshold'], morph_size=values['morph_size'])
 
 
+#: Methods that update a per-pixel model with every frame instead of solving windows.
+ONLINE_METHODS = ('mog2', 'knn')
+
+
+def window_model(values):
+    """Return the estimator that separates one window by ``values['method']``."""
+    method = values['method']
+    if method == 'dgmod':
+        return build_model(values)
+    if method == 'median':
+        return TemporalMedian()
+    if method in ONLINE_METHODS:
+        return OpenCVWindowModel(method)
+    raise ValueError(f'unknown method {method!r}')
+
+
 def detector_settings(values):
     """Return the keyword arguments of the streaming detector the values describe."""
-    if values['method'] != 'dgmod':
+    if values['method'] in ONLINE_METHODS:
         return {'kind': values['method'], 'scale': values['scale'], 'color': values['color'],
                 'morph_size': values['morph_size']}
-    return {'model': build_model(values), 'window': values['window'],
+    return {'model': window_model(values), 'window': values['window'],
             'stride': values['stride'], 'scale': values['scale'], 'color': values['color'],
             'mask_rule': build_mask_rule(values),
             'motion_threshold': values['motion_threshold'],
@@ -158,11 +176,11 @@ def validate(values):
             raise ValueError(f'unknown parameter {name!r}')
         check_value(name, value)
     settings = detector_settings(values)
-    if values['method'] == 'dgmod':
-        SlidingWindowDetector(**settings).validate()
-        settings['model'].check_parameters()
-    else:
+    if values['method'] in ONLINE_METHODS:
         OpenCVSubtractor(**settings).validate()
+    else:
+        SlidingWindowDetector(**settings).validate()
+        build_model(values).check_parameters()
     return values
 
 
@@ -170,9 +188,9 @@ def build_detector(values):
     """Return a validated streaming detector for a complete set of values."""
     validate(values)
     settings = detector_settings(values)
-    if values['method'] == 'dgmod':
-        return SlidingWindowDetector(**settings).validate()
-    return OpenCVSubtractor(**settings).validate()
+    if values['method'] in ONLINE_METHODS:
+        return OpenCVSubtractor(**settings).validate()
+    return SlidingWindowDetector(**settings).validate()
 
 
 def load_parameter_file(path):

@@ -135,7 +135,8 @@ class DetectorNode(Node):
         if solved is not None:
             self._stats.solved(solved.seconds, solved.iterations, solved.info)
             self._publish_background(solved, msg.header)
-        elif self._values['method'] != 'dgmod' and result.frame_id % self._values['stride'] == 0:
+        elif (self._values['method'] in config.ONLINE_METHODS
+              and result.frame_id % self._values['stride'] == 0):
             self._publish_opencv_background(msg.header)
         if self._overlay_pub is not None:
             self._publish_overlay(image, order, value_range, result.mask, msg.header)
@@ -201,7 +202,8 @@ class DetectorNode(Node):
         values = dict(self._values)
         values.update(changed)
         with self._lock:
-            if values['method'] != self._values['method']:
+            if (values['method'] in config.ONLINE_METHODS) != \
+                    (self._values['method'] in config.ONLINE_METHODS):
                 self._detector = config.build_detector(values)
             else:
                 self._detector.configure(**config.detector_settings(values))
@@ -245,7 +247,7 @@ class DetectorNode(Node):
             problems.append(f"{figures['frames_dropped']} frames dropped")
         if figures['solve_failures']:
             problems.append(f"{figures['solve_failures']} solves failed")
-        if not figures['model_ready'] and self._values['method'] == 'dgmod':
+        if not figures['model_ready'] and self._values['method'] not in config.ONLINE_METHODS:
             problems.append('warming up: no window solved yet')
         status.level = DiagnosticStatus.WARN if problems else DiagnosticStatus.OK
         status.message = '; '.join(problems) or 'masks published for every frame'

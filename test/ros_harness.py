@@ -8,7 +8,7 @@ from dgmod_ros.detector_node import DetectorNode
 from dgmod_ros.image_conversion import array_to_image_fields, image_to_array
 import rclpy
 from rclpy.context import Context
-from rclpy.executors import MultiThreadedExecutor
+from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile
 from sensor_msgs.msg import Image
@@ -41,7 +41,7 @@ class DetectorHarness:
                                         QoSProfile(depth=1000))
         self.client.create_subscription(Image, 'background', self.backgrounds.append,
                                         QoSProfile(depth=1000))
-        self.executor = MultiThreadedExecutor(num_threads=3, context=self.context)
+        self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)
         self.executor.add_node(self.client)
         self.spin_until(lambda: self.publisher.get_subscription_count() > 0, 10.0)
@@ -55,8 +55,16 @@ class DetectorHarness:
             self.executor.spin_once(timeout_sec=0.02)
         return condition()
 
-    def send(self, msg, expect_mask=True, timeout=10.0):
-        """Publish one frame and wait for its mask (or for it to be counted as dropped)."""
+    def send(self, msg, expect_mask=True, timeout=10.0, period=0.0):
+        """
+        Publish one frame and wait for its mask (or for it to be counted as dropped).
+
+        With ``period`` > 0, frames are paced like a camera: this call returns no
+        earlier than ``period`` seconds after the previous one.
+        """
+        if period > 0 and hasattr(self, '_last_send'):
+            self.spin_until(lambda: time.monotonic() >= self._last_send + period, period)
+        self._last_send = time.monotonic()
         before_masks = len(self.masks)
         before = self.node.statistics()
         handled = before['masks_out'] + before['frames_dropped']

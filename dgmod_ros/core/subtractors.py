@@ -128,3 +128,41 @@ class OpenCVSubtractor:
         image = self.subtractor_.getBackgroundImage()
         image = image.astype(np.float32) / 255.0
         return image[:, :, None] if image.ndim == 2 else image[:, :, ::-1]
+
+
+class OpenCVWindowModel:
+    """
+    An OpenCV subtractor as a window method (``batch`` mode).
+
+    Every window trains a fresh subtractor on all its frames, then masks each
+    frame with learning switched off, so every mask uses the whole window, as
+    the window methods do. ``foreground_`` is 1 where OpenCV says foreground
+    (255) and 0 elsewhere, so any mask threshold below 1 reproduces its mask.
+
+    Parameters
+    ----------
+    kind : {'mog2', 'knn'}, default='mog2'
+        Which subtractor.
+
+    """
+
+    def __init__(self, kind='mog2'):
+        self.kind = kind
+
+    def fit(self, data, frame_shape, init=None):
+        """Train on the window's frames, then mask each (``init`` is unused)."""
+        if self.kind not in _FACTORIES:
+            raise ValueError(f"kind must be 'mog2' or 'knn', got {self.kind!r}")
+        data = np.asarray(data, dtype=np.float32)
+        rows, cols = frame_shape
+        frames = np.clip(data * 255.0 + 0.5, 0, 255).astype(np.uint8).T.reshape(-1, rows, cols)
+        subtractor = _FACTORIES[self.kind]()
+        for frame in frames:
+            subtractor.apply(frame)
+        masks = np.stack([subtractor.apply(frame, learningRate=0.0) == 255 for frame in frames])
+        self.foreground_ = masks.reshape(len(frames), -1).T.astype(np.float32)
+        background = subtractor.getBackgroundImage().astype(np.float32).ravel() / 255.0
+        self.background_ = np.repeat(background[:, None], len(frames), axis=1)
+        self.n_iter_ = 1
+        self.info_ = 0
+        return self
