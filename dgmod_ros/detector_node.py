@@ -23,14 +23,14 @@ import rclpy
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
 from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 from rclpy.node import Node
-from rclpy.qos import QoSProfile, qos_profile_sensor_data
+from rclpy.qos import qos_profile_sensor_data, QoSProfile
 from rclpy.qos_overriding_options import QoSOverridingOptions
 from sensor_msgs.msg import Image
 
 from . import config
 from .core.preprocess import to_float_channels
 from .core.window import SolverFailure
-from .image_conversion import array_to_image_fields, ImageConversionError, image_to_array
+from .image_conversion import array_to_image_fields, image_to_array, ImageConversionError
 from .solve_worker import SolveWorker
 from .stats import DetectorStats
 

@@ -4,8 +4,8 @@
 
 from types import SimpleNamespace
 
-from dgmod_ros.image_conversion import (array_to_image_fields, ENCODINGS,
-                                        ImageConversionError, image_to_array)
+from dgmod_ros.image_conversion import (array_to_image_fields, ENCODINGS, image_to_array,
+                                        ImageConversionError)
 from hypothesis import given, settings, strategies as st
 import numpy as np
 import pytest
