@@ -168,8 +168,9 @@ def main(argv=None):
         print(f'demo: error: {error}', file=sys.stderr)
         return 2
     source = args.input or 'synthetic 320 x 240 scene'
-    print(f"demo: {figures['frames']} frames of {source} replayed at 30 frames/s through "
-          f"the detector node; outputs in {args.out}/")
+    frames = figures['frames']
+    print(f'demo: {frames} frames of {source} replayed at 30 frames/s through '
+          f'the detector node; outputs in {args.out}/')
     print(f"  masks: {figures['masks_written']} written, {figures['frames_dropped']} frames "
           f"dropped; {figures['solves']} window solves")
     if 'mean_iou' in figures:

@@ -105,4 +105,3 @@ def test_installed_detector_masks_frames_and_stops_cleanly(install, monkeypatch,
     assert process.returncode == 0, output
     assert 'Traceback' not in output, output
     assert stopped < 2.0, f'shutdown took {stopped:.2f} s'
-
