@@ -1,7 +1,7 @@
 # Copyright 2026 dgmod_ros authors
 # Licensed under the Apache License, Version 2.0
 """
-``dgmod``: the offline command.
+``dgmod``: the offline command (``separate`` and ``evaluate``).
 
 ``dgmod separate INPUT --out DIR`` runs one method over a folder of frames, a
 video or a rosbag2 and writes ``DIR/masks/<stem>.png``,
@@ -24,9 +24,10 @@ import cv2
 import numpy as np
 
 from . import config
-from .core.pipeline import batch_separate
 from .core.runtime import keep_freed_memory
+from .evaluation import evaluate
 from .inputs import BadInput, count_frames, read_frames
+from .sequence import results
 
 
 class Progress:
@@ -99,6 +100,16 @@ def build_parser():
     separate.add_argument('--force', action='store_true', help='replace an existing --out')
     separate.add_argument('--quiet', action='store_true', help='no progress bar')
     _add_parameter_options(separate)
+    evaluate = commands.add_parser('evaluate', help="the paper's comparison on CDnet-style "
+                                   'datasets with ground truth')
+    evaluate.add_argument('datasets', nargs='+', help='CDnet-style folders (input/, '
+                          'groundtruth/, temporalROI.txt)')
+    evaluate.add_argument('--methods', default=','.join(config.BY_NAME['method'].choices),
+                          help='comma-separated methods (default: all)')
+    evaluate.add_argument('--mode', choices=('stream', 'batch'), default='stream')
+    evaluate.add_argument('--out', required=True, help='folder for results and figures')
+    evaluate.add_argument('--config', help="the node's YAML parameter file")
+    _add_parameter_options(evaluate)
     return parser
 
 
@@ -159,52 +170,6 @@ def _background_png(background):
     return cv2.cvtColor(pixels, cv2.COLOR_RGB2BGR) if pixels.ndim == 3 else pixels
 
 
-def run_stream(frames, values, out, progress):
-    """Run the node's streaming detector over the frames; return the solve records."""
-    detector = config.build_detector(values)
-    windows = []
-    value_range = values['value_range'] or None
-    for frame in frames:
-        result, solved = detector.process(frame.image, frame.channel_order, value_range)
-        _write_png(out / 'masks' / f'{frame.stem}.png', result.mask)
-        if solved is not None:
-            windows.append({'first_frame': solved.first_id, 'last_frame': solved.last_id,
-                            'seconds': solved.seconds, 'iterations': solved.iterations,
-                            'info': solved.info})
-            background = cv2.resize(solved.background, frame.image.shape[1::-1])
-            _write_png(out / 'background' / f'{frame.stem}.png', _background_png(background))
-        elif values['method'] in config.ONLINE_METHODS and \
-                result.frame_id % values['stride'] == values['stride'] - 1:
-            background = cv2.resize(detector.background_image(), frame.image.shape[1::-1])
-            _write_png(out / 'background' / f'{frame.stem}.png', _background_png(background))
-        progress.step()
-    return windows
-
-
-def run_batch(frames, values, out, progress):
-    """Tile the sequence with windows; return the solve records."""
-    frames = list(frames)
-    if not frames:
-        return []
-    order = frames[0].channel_order
-    model = config.window_model(values)
-    windows = []
-    separated = batch_separate([f.image for f in frames], model, window=values['window'],
-                               scale=values['scale'], color=values['color'],
-                               mask_rule=config.build_mask_rule(values), channel_order=order,
-                               value_range=values['value_range'] or None)
-    for index, mask, background, record in separated:
-        stem = frames[index].stem
-        _write_png(out / 'masks' / f'{stem}.png', mask)
-        if record is not None:
-            windows.append({'first_frame': record.first, 'last_frame': record.last,
-                            'seconds': record.seconds, 'iterations': record.iterations})
-            full = cv2.resize(background, frames[index].image.shape[1::-1])
-            _write_png(out / 'background' / f'{stem}.png', _background_png(full))
-        progress.step()
-    return windows
-
-
 def separate(args):
     """Run ``dgmod separate``; return the report dict."""
     values = resolve_parameters(args)
@@ -219,10 +184,17 @@ def separate(args):
     progress = Progress(f'{values["method"]} {args.mode}', count_frames(args.input, args.topic),
                         stream=io.StringIO() if args.quiet else sys.stderr)
     started = time.perf_counter()
+    windows = []
     try:
         frames = _good_frames(read_frames(args.input, args.topic), args.skip_bad, skipped)
-        runner = run_stream if args.mode == 'stream' else run_batch
-        windows = runner(frames, values, partial, progress)
+        for frame, mask, background, window in results(frames, values, args.mode):
+            _write_png(partial / 'masks' / f'{frame.stem}.png', mask)
+            if background is not None:
+                _write_png(partial / 'background' / f'{frame.stem}.png',
+                           _background_png(background))
+            if window is not None:
+                windows.append(window)
+            progress.step()
     except BaseException:
         shutil.rmtree(partial, ignore_errors=True)
         raise
@@ -245,6 +217,22 @@ def separate(args):
     return report
 
 
+def run_evaluation(args):
+    """Run ``dgmod evaluate`` and print one line per (dataset, method)."""
+    values = resolve_parameters(args)
+    methods = [m.strip() for m in args.methods.split(',') if m.strip()]
+    for method in methods:
+        config.check_value('method', method)
+
+    def show(row):
+        print(f"{row['dataset']:>14} {row['method']:>7}: F {row['fmeasure']:.3f} (Pr "
+              f"{row['precision']:.3f}, Re {row['recall']:.3f}), {row['fps']:.1f} frames/s",
+              file=sys.stderr, flush=True)
+
+    evaluate(args.datasets, methods, values, args.mode, args.out, show)
+    print(f'results in {args.out}/results.md, results.json and figure*.png')
+
+
 def main(argv=None):
     """Entry point of ``dgmod``; returns the exit status."""
     keep_freed_memory()
@@ -255,6 +243,8 @@ def main(argv=None):
             print(f"{report['frames']} frames in {report['seconds']:.1f} s "
                   f"({report['fps']:.1f} frames/s), {len(report['windows'])} window solves, "
                   f"{len(report['skipped'])} skipped; outputs in {args.out}")
+        else:
+            run_evaluation(args)
     except (BadInput, ValueError, OSError) as error:
         print(f'dgmod: error: {error}', file=sys.stderr)
         return 2

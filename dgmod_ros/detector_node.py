@@ -75,6 +75,7 @@ class DetectorNode(Node):
         self._lock = threading.Lock()       # guards the detector between callbacks
         self._stats = DetectorStats()
         self._last_header = None
+        self._encoding = None
         self._worker = SolveWorker(self._solve, self._on_solved, self._on_solve_error)
 
         images = MutuallyExclusiveCallbackGroup()
@@ -111,6 +112,13 @@ class DetectorNode(Node):
         value_range = self._values['value_range'] or None
         with self._lock:
             self._last_header = msg.header
+            if self._encoding is not None and msg.encoding != self._encoding:
+                # Same size, other meaning (colour to depth, say): restart too.
+                self._detector.reset()
+                self._stats.window_reset()
+                self.get_logger().info(f'encoding changed from {self._encoding} to '
+                                       f'{msg.encoding}: window restarted')
+            self._encoding = msg.encoding
             try:
                 if self._values['solve_mode'] == 'sync':
                     result, solved = self._detector.process(image, order or 'rgb', value_range)
@@ -236,6 +244,7 @@ class DetectorNode(Node):
             figures['window_frames'] = len(buffer)
             figures['model_ready'] = getattr(self._detector, 'background_model_',
                                              None) is not None
+            figures['scene_changes'] = getattr(self._detector, 'scene_changes_', 0)
         return figures
 
     def _publish_diagnostics(self):

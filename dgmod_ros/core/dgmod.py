@@ -81,7 +81,7 @@ class DualGraphMOD:
     ----------
     lambda1 : float or None, default=None
         Weight of the weighted nuclear norm. None: ``lambda2 * sqrt(max(n, m))``,
-        the balance of classical PCP.
+        the balance of classical PCP. 0 drops the term (the FRPCAG model).
     lambda2 : float, default=0.5
         Weight of ``||S||_1``; must be below 1 (see above).
     gamma1 : float, default=0.5
@@ -186,7 +186,10 @@ class DualGraphMOD:
             value = getattr(self, name)
             if not (np.isfinite(value) and value >= 0):
                 raise ValueError(f'{name} must be a non-negative finite number, got {value!r}')
-        for name in ('lambda1', 'weight_scale', 'h_s', 'h_t', 'step_size'):
+        if self.lambda1 is not None and not (np.isfinite(self.lambda1) and self.lambda1 >= 0):
+            raise ValueError(f'lambda1 must be None or a non-negative finite number, '
+                             f'got {self.lambda1!r}')
+        for name in ('weight_scale', 'h_s', 'h_t', 'step_size'):
             value = getattr(self, name)
             if value is not None and not (np.isfinite(value) and value > 0):
                 raise ValueError(f'{name} must be None or a positive finite number, got {value!r}')
@@ -230,6 +233,8 @@ class DualGraphMOD:
 
     def _weighted_svt(self, matrix, weights, threshold):
         """Return ``A diag(shrink(sigma, w * t)) B^T``, the singular values and the rank kept."""
+        if threshold == 0:          # no nuclear norm (FRPCAG): the prox is the identity
+            return matrix.copy(), np.zeros(matrix.shape[1]), matrix.shape[1]
         if self.svd == 'full':
             left, sigma, right_t = np.linalg.svd(matrix, full_matrices=False)
             shrunk = np.maximum(sigma - weights[:sigma.size] * threshold, 0)

@@ -135,11 +135,20 @@ class SlidingWindowDetector:
         The window's background can hold slow foreground (a person lingering
         for part of the window shows up as a weak extra component); keeping
         the dominant components keeps the scene and its illumination.
+    global_change_fraction : float, default=0.7
+        When the fast path marks more than this fraction of two consecutive
+        frames as foreground, the scene itself changed (lights switched, an
+        exposure jump, a bumped camera): the window is restarted from those
+        two frames, so masks are all-foreground for at most two frames. A
+        global gain change needs no restart (the projection absorbs it). 1.0
+        disables the rule; a person filling more of the view than this
+        fraction would also restart the window.
 
     """
 
     def __init__(self, model=None, window=30, stride=10, scale=0.5, color='gray',
-                 mask_rule=None, motion_threshold=0.0, min_frames=5, basis_rank=2):
+                 mask_rule=None, motion_threshold=0.0, min_frames=5, basis_rank=2,
+                 global_change_fraction=0.7):
         self.model = model
         self.window = window
         self.stride = stride
@@ -149,6 +158,7 @@ class SlidingWindowDetector:
         self.motion_threshold = motion_threshold
         self.min_frames = min_frames
         self.basis_rank = basis_rank
+        self.global_change_fraction = global_change_fraction
         self._validated = False
 
     # ------------------------------------------------------------- set-up
@@ -168,6 +178,9 @@ class SlidingWindowDetector:
         if int(self.min_frames) != self.min_frames or not 2 <= self.min_frames <= self.window:
             raise ValueError(f'min_frames must be an integer in [2, window={self.window}], '
                              f'got {self.min_frames!r}')
+        if not 0 < self.global_change_fraction <= 1:
+            raise ValueError(f'global_change_fraction must be in (0, 1], got '
+                             f'{self.global_change_fraction!r}')
         if int(self.basis_rank) != self.basis_rank or self.basis_rank < 1:
             raise ValueError(f'basis_rank must be a positive integer, got {self.basis_rank!r}')
         (self.mask_rule or MaskRule()).validate()
@@ -177,8 +190,9 @@ class SlidingWindowDetector:
     def _ensure_started(self):
         if not self._validated:
             self.validate()
-        if not hasattr(self, 'buffer_'):
+        if not hasattr(self, 'model_'):
             self._build_helpers()
+        if not hasattr(self, 'buffer_'):
             self.reset()
 
     def _build_helpers(self):
@@ -242,6 +256,8 @@ class SlidingWindowDetector:
         self.shape_ = None
         self.next_id_ = 0
         self.since_solve_ = 0
+        self.changed_frames_ = 0
+        self.scene_changes_ = getattr(self, 'scene_changes_', 0)
 
     # ------------------------------------------------------------- per frame
     def _columns(self, frame, channel_order, value_range):
@@ -335,7 +351,25 @@ class SlidingWindowDetector:
         result.magnitude, threshold = self._fast_path(columns)
         result.mask = self.mask_rule_.apply(result.magnitude, threshold, self.input_shape_)
         result.model_ready = self.background_model_ is not None
+        if self.global_change_fraction < 1 and self.buffer_:
+            changed = np.count_nonzero(result.mask) > self.global_change_fraction * result.mask.size
+            self.changed_frames_ = self.changed_frames_ + 1 if changed else 0
+            if self.changed_frames_ >= 2:
+                self._restart_from_recent(2)
         return result
+
+    def _restart_from_recent(self, count):
+        """Keep only the newest ``count`` frames and drop the model (a scene change)."""
+        recent = list(zip(self.ids_, self.buffer_))[-count:]
+        self.buffer_.clear()
+        self.ids_.clear()
+        for frame_id, columns in recent:
+            self.ids_.append(frame_id)
+            self.buffer_.append(columns)
+        self.background_model_ = None
+        self.since_solve_ = len(recent)
+        self.changed_frames_ = 0
+        self.scene_changes_ += 1
 
     def _fast_path(self, columns):
         rows, cols, _ = self.shape_

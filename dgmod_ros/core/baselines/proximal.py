@@ -1,0 +1,91 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""Proximal and projection operators shared by the fastRPCA-style baselines."""
+
+import numpy as np
+
+from ..linalg import shrink
+
+
+def singular_value_map(matrix, transform):
+    """
+    Return ``A diag(transform(sigma)) B^T`` for the thin SVD ``A diag(sigma) B^T``.
+
+    Goes through the m x m Gram matrix (``matrix`` is tall). ``transform`` maps
+    the descending singular values to new non-negative ones.
+    """
+    gram = (matrix.T @ matrix).astype(np.float64)
+    eigval, eigvec = np.linalg.eigh(gram)
+    sigma = np.sqrt(np.clip(eigval[::-1], 0.0, None))
+    eigvec = eigvec[:, ::-1]
+    new = np.asarray(transform(sigma), dtype=np.float64)
+    keep = (new > 0) & (sigma > 1e-12 * max(sigma[0], 1e-300))
+    mixing = (eigvec[:, keep] * (new[keep] / sigma[keep])) @ eigvec[:, keep].T
+    return matrix @ mixing.astype(matrix.dtype), int(np.count_nonzero(keep))
+
+
+def singular_value_threshold(matrix, threshold):
+    """Return the prox of ``threshold * ||.||_*`` at ``matrix`` and the rank kept."""
+    return singular_value_map(matrix, lambda s: np.maximum(s - threshold, 0.0))
+
+
+def project_simplex_budget(values, budget):
+    """Project non-negative ``values`` onto ``{x >= 0, sum(x) <= budget}``."""
+    values = np.maximum(np.asarray(values, dtype=np.float64), 0.0)
+    if values.sum() <= budget:
+        return values
+    ordered = np.sort(values)[::-1]
+    cumulative = np.cumsum(ordered) - budget
+    index = np.arange(1, ordered.size + 1)
+    rho = np.nonzero(ordered - cumulative / index > 0)[0][-1]
+    theta = cumulative[rho] / (rho + 1)
+    return np.maximum(values - theta, 0.0)
+
+
+def project_nuclear_ball(matrix, radius):
+    """Project onto ``{||X||_* <= radius}``; return the projection and its rank."""
+    return singular_value_map(matrix, lambda s: project_simplex_budget(s, radius))
+
+
+def project_l1_ball(matrix, radius):
+    """Project onto ``{||X||_1 <= radius}`` (sort-based, Duchi et al. 2008)."""
+    magnitude = np.abs(matrix).ravel()
+    if magnitude.sum() <= radius:
+        return matrix.copy()
+    projected = project_simplex_budget(magnitude, radius)
+    theta = float(np.max(magnitude - projected))
+    return shrink(matrix, theta)
+
+
+def quasi_newton_sls(data, prox_low_rank, prox_sparse, low_rank, sparse, tol, max_iter,
+                     step=0.8):
+    """
+    Run fastRPCA's quasi-Newton S-L-S iteration on ``0.5 ||L + S - D||_F^2 + g(L) + h(S)``.
+
+    ``prox_low_rank(X, t)`` and ``prox_sparse(X, t)`` are the proximal (or
+    projection) steps of g and h for step ``t``. Stops when the residual norm
+    ``||L + S - D||_F`` changes by less than ``tol`` relative, as fastRPCA does.
+
+    Returns
+    -------
+    low_rank, sparse : ndarray
+    iterations : int
+    converged : bool
+    rank : int
+
+    """
+    previous_low_rank = low_rank
+    residual_norm = np.inf
+    rank = 0
+    for iteration in range(1, max_iter + 1):
+        gradient = low_rank + sparse - data
+        trial = prox_sparse(sparse - step * (gradient + (low_rank - previous_low_rank)), step)
+        previous_low_rank = low_rank
+        low_rank, rank = prox_low_rank(low_rank - step * (low_rank + trial - data), step)
+        sparse = prox_sparse(sparse - step * (low_rank + sparse - data), step)
+        new_norm = float(np.linalg.norm(low_rank + sparse - data))
+        if np.isfinite(residual_norm) and \
+                abs(residual_norm - new_norm) <= tol * max(new_norm, 1e-30):
+            return low_rank, sparse, iteration, True, rank
+        residual_norm = new_norm
+    return low_rank, sparse, max_iter, False, rank

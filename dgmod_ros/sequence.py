@@ -1,0 +1,62 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""Run one method over a sequence of frames, in stream or batch mode (no ROS import)."""
+
+import cv2
+
+from . import config
+from .core.pipeline import batch_separate
+
+
+def _at_input_size(background, frame):
+    return cv2.resize(background, frame.image.shape[1::-1]).reshape(
+        frame.image.shape[:2] + (-1,))
+
+
+def stream_results(frames, values):
+    """
+    Yield ``(frame, mask, background, window)`` the way the node computes them.
+
+    ``background`` (float [0, 1], input size, (h, w, C)) and ``window`` (a
+    dict with ``seconds`` and ``iterations``) are None except at a solve.
+    """
+    detector = config.build_detector(values)
+    value_range = values['value_range'] or None
+    online = values['method'] in config.ONLINE_METHODS
+    for frame in frames:
+        result, solved = detector.process(frame.image, frame.channel_order, value_range)
+        background, window = None, None
+        if solved is not None:
+            window = {'first_frame': solved.first_id, 'last_frame': solved.last_id,
+                      'seconds': solved.seconds, 'iterations': solved.iterations,
+                      'info': solved.info}
+            background = _at_input_size(solved.background, frame)
+        elif online and result.frame_id % values['stride'] == values['stride'] - 1:
+            background = _at_input_size(detector.background_image(), frame)
+        yield frame, result.mask, background, window
+
+
+def batch_results(frames, values):
+    """Yield ``(frame, mask, background, window)`` with windows tiling the sequence."""
+    frames = list(frames)
+    if not frames:
+        return
+    separated = batch_separate(
+        [f.image for f in frames], config.window_model(values), window=values['window'],
+        scale=values['scale'], color=values['color'], mask_rule=config.build_mask_rule(values),
+        channel_order=frames[0].channel_order, value_range=values['value_range'] or None)
+    for index, mask, background, record in separated:
+        frame = frames[index]
+        window = None
+        if record is not None:
+            window = {'first_frame': record.first, 'last_frame': record.last,
+                      'seconds': record.seconds, 'iterations': record.iterations}
+            background = _at_input_size(background, frame)
+        yield frame, mask, background, window
+
+
+def results(frames, values, mode):
+    """Dispatch to :func:`stream_results` or :func:`batch_results`."""
+    if mode not in ('stream', 'batch'):
+        raise ValueError(f"mode must be 'stream' or 'batch', got {mode!r}")
+    return (stream_results if mode == 'stream' else batch_results)(frames, values)
