@@ -133,18 +133,11 @@ def resolve_parameters(args):
 def _good_frames(frames, skip_bad, skipped):
     """Yield frames of the first frame's size; stop on a bad one unless skipping."""
     size = None
-    iterator = iter(frames)
-    while True:
-        try:
-            frame = next(iterator)
-        except StopIteration:
-            return
-        except BadInput as error:
+    for frame in frames:
+        if isinstance(frame, BadInput):
             if not skip_bad:
-                raise
-            skipped.append({'frame': None, 'reason': str(error)})
-            if 'cannot open' in str(error) or 'no readable' in str(error):
-                return
+                raise frame
+            skipped.append({'frame': None, 'reason': str(frame)})
             continue
         if size is None:
             size = frame.image.shape[:2]

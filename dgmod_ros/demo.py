@@ -42,6 +42,8 @@ def _load(source):
             [f'{i:06d}' for i in range(150)]
     frames, stems = [], []
     for frame in read_frames(source):
+        if isinstance(frame, BadInput):
+            raise frame
         image = frame.image
         if image.ndim == 2:
             image = cv2.cvtColor(image, cv2.COLOR_GRAY2RGB)

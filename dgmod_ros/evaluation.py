@@ -106,6 +106,9 @@ def evaluate(paths, methods, values, mode, out, progress=None):
     for path in paths:
         dataset = load_dataset(path)
         frames = list(read_frames(dataset.path))
+        bad = [f for f in frames if isinstance(f, BadInput)]
+        if bad:
+            raise bad[0]
         if len(frames) != len(dataset.truths):
             raise BadInput(f'{dataset.path}: {len(frames)} frames but '
                            f'{len(dataset.truths)} ground-truth masks')

@@ -4,8 +4,9 @@
 Frame sources for the command line: image folders, video files, rosbag2 bags.
 
 Each source yields :class:`Frame` objects in order. A frame that cannot be
-decoded raises :class:`BadInput` with one sentence naming it; callers decide
-whether to stop or to skip. rosbag2 is read with ``rosbags`` (pure Python), so
+decoded is yielded as a :class:`BadInput` (one sentence naming it), so that a
+caller can stop or skip it and go on; an input that cannot be opened at all
+raises :class:`BadInput`. rosbag2 is read with ``rosbags`` (pure Python), so
 no ROS installation is needed.
 """
 
@@ -48,7 +49,8 @@ def _read_folder(folder):
     for index, path in enumerate(_folder_images(folder)):
         image = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
         if image is None or image.size == 0:
-            raise BadInput(f'cannot decode image {path}')
+            yield BadInput(f'cannot decode image {path}')
+            continue
         if image.ndim == 3 and image.shape[2] == 4:
             image = image[:, :, :3]
         yield Frame(index, path.stem, image, 'bgr')
@@ -106,11 +108,12 @@ def _read_bag(path, topic):
                 msg = store.deserialize_cdr(raw, connection.msgtype)
                 image, order = image_to_array(msg)
             except ImageConversionError as error:
-                raise BadInput(f'message {index} of {connection.topic} (t={stamp} ns): '
-                               f'{error}') from error
+                yield BadInput(f'message {index} of {connection.topic} (t={stamp} ns): {error}')
+                continue
             except Exception as error:  # noqa: B902 - a corrupt CDR buffer
-                raise BadInput(f'message {index} of {connection.topic} (t={stamp} ns) cannot '
-                               f'be decoded: {error}') from error
+                yield BadInput(f'message {index} of {connection.topic} (t={stamp} ns) cannot '
+                               f'be decoded: {error}')
+                continue
             yield Frame(index, f'{index:06d}', image, order or 'rgb')
     finally:
         reader.close()
@@ -134,7 +137,7 @@ def input_kind(path):
 
 def read_frames(path, topic=None):
     """
-    Yield the frames of an input in order.
+    Yield the frames of an input in order (a :class:`BadInput` for an unreadable one).
 
     Parameters
     ----------

