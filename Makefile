@@ -4,7 +4,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.requirements-installed
 
-.PHONY: demo test bench clean
+.PHONY: demo test bench bench-node bench-soak clean
 
 $(STAMP): requirements.txt
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -20,6 +20,12 @@ test: $(STAMP)
 
 bench: $(STAMP)
 	PYTHONPATH=. $(PY) benchmarks/bench_solver.py
+
+bench-node: $(STAMP)
+	PYTHONPATH=. $(PY) benchmarks/bench_node.py
+
+bench-soak: $(STAMP)
+	PYTHONPATH=. $(PY) benchmarks/bench_soak.py
 
 clean:
 	rm -rf $(VENV) out

@@ -2,12 +2,12 @@
 # Licensed under the Apache License, Version 2.0
 """The robust dual-graph regularized separation model and its ADMM solver."""
 
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from .graphs import spatial_laplacian, temporal_laplacian
-from .linalg import relative_change, shrink
+from .linalg import drop_oldest, relative_change, shrink
 
 
 @dataclass
@@ -43,19 +43,11 @@ class ADMMState:
             return self
         if fill_column is None:
             fill_column = self.background[:, -1]
-        arrays = {}
-        for field in fields(self):
-            value = getattr(self, field.name)
-            if field.name == 'weights':
-                arrays[field.name] = value
-                continue
-            rolled = np.empty_like(value)
-            rolled[:, :-count] = value[:, count:]
-            if field.name in ('background', 'low_rank'):
-                rolled[:, -count:] = fill_column[:, None]
-            else:
-                rolled[:, -count:] = 0.0
-            arrays[field.name] = rolled
+        fill = fill_column[:, None]
+        arrays = {name: drop_oldest(getattr(self, name), count,
+                                    fill if name in ('background', 'low_rank') else 0.0)
+                  for name in ('background', 'foreground', 'low_rank', 'noise',
+                               'dual_low_rank', 'dual_noise')}
         return replace(self, **arrays)
 
 

@@ -56,3 +56,23 @@ def relative_change(new, old):
     if denom == 0.0:
         return 0.0 if diff == 0.0 else np.inf
     return float(diff / denom)
+
+
+def drop_oldest(array, count, fill, axis=1):
+    """
+    Return ``array`` with its first ``count`` slices along ``axis`` dropped.
+
+    The remaining slices move to the front and the last ``count`` are set to
+    ``fill`` (broadcast): the warm start of a window that moved by ``count``
+    frames. ``axis`` is the frame axis (1 for n x m matrices, 0 for m x k factors).
+    """
+    moved = np.empty_like(array)
+    front = [slice(None)] * array.ndim
+    back = [slice(None)] * array.ndim
+    source = [slice(None)] * array.ndim
+    front[axis] = slice(None, -count)
+    source[axis] = slice(count, None)
+    back[axis] = slice(-count, None)
+    moved[tuple(front)] = array[tuple(source)]
+    moved[tuple(back)] = fill
+    return moved

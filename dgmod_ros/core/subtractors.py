@@ -6,7 +6,7 @@ import cv2
 import numpy as np
 
 from .preprocess import processing_shape, resize, to_float_channels
-from .window import FrameResult
+from .window import assign_validated, FrameResult
 
 _FACTORIES = {
     'mog2': cv2.createBackgroundSubtractorMOG2,
@@ -73,15 +73,7 @@ class OpenCVSubtractor:
 
     def configure(self, **params):
         """Change parameters (validated first); the background model restarts."""
-        old = {name: getattr(self, name) for name in params}
-        for name, value in params.items():
-            setattr(self, name, value)
-        try:
-            self.validate()
-        except ValueError:
-            for name, value in old.items():
-                setattr(self, name, value)
-            raise
+        assign_validated(self, params)
         self.reset()
         return self
 

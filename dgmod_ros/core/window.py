@@ -214,15 +214,7 @@ class SlidingWindowDetector:
         unknown = set(params) - set(self.__init__.__code__.co_varnames[1:])
         if unknown:
             raise ValueError(f'unknown parameters: {", ".join(sorted(unknown))}')
-        old = {name: getattr(self, name) for name in params}
-        for name, value in params.items():
-            setattr(self, name, value)
-        try:
-            self.validate()
-        except ValueError:
-            for name, value in old.items():
-                setattr(self, name, value)
-            raise
+        old = assign_validated(self, params)
         if not hasattr(self, 'buffer_'):
             return self
         self._build_helpers()
@@ -476,6 +468,24 @@ class SlidingWindowDetector:
             return False
         self.background_model_ = model
         return True
+
+
+def assign_validated(target, params):
+    """
+    Set attributes on ``target`` and run its ``validate()``; undo all on ValueError.
+
+    Returns the previous values of the attributes that were set.
+    """
+    old = {name: getattr(target, name) for name in params}
+    for name, value in params.items():
+        setattr(target, name, value)
+    try:
+        target.validate()
+    except ValueError:
+        for name, value in old.items():
+            setattr(target, name, value)
+        raise
+    return old
 
 
 def background_basis(background, max_rank=None):

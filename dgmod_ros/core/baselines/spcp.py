@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import minimize
 
-from ..linalg import shrink
+from ..linalg import drop_oldest, shrink
 from .lago import _checked
 
 
@@ -27,10 +27,7 @@ class FactorState:
         """Factors for a window that dropped ``count`` frames (new rows repeat the last)."""
         if count <= 0:
             return self
-        right = np.empty_like(self.right)
-        right[:-count] = self.right[count:]
-        right[-count:] = self.right[-1]
-        return FactorState(self.left, right)
+        return FactorState(self.left, drop_oldest(self.right, count, self.right[-1], axis=0))
 
 
 class SplitSPCP:

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..linalg import drop_oldest
 from .lago import _checked
 from .proximal import project_l1_ball, project_nuclear_ball, quasi_newton_sls
 
@@ -26,10 +27,8 @@ class LevelState:
         """State of a window that dropped ``count`` frames (new columns repeat the last)."""
         if count <= 0:
             return self
-        background = np.empty_like(self.background)
-        background[:, :-count] = self.background[:, count:]
-        background[:, -count:] = self.background[:, -1:]
-        return LevelState(background, self.tau)
+        return LevelState(drop_oldest(self.background, count, self.background[:, -1:]),
+                          self.tau)
 
 
 class SPGL1RPCA:
