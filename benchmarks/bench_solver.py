@@ -53,7 +53,7 @@ def load_window():
 def fmeasure(model, data, masks):
     """Score the window's masks (default mask rule) at the ground truth's size."""
     rule = MaskRule()
-    threshold = rule.estimate_threshold(data - model.background_)
+    threshold = rule.estimate_threshold(data - model.background_, data)
     counts = ConfusionCounts()
     for j, truth in enumerate(masks):
         magnitude = np.abs(model.foreground_[:, j]).reshape(SHAPE)

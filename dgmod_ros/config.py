@@ -89,7 +89,11 @@ PARAMETERS = (
     Parameter('inner_iter', 1, 'gradient steps or CG iterations per L-step (T_in)', 1, 50),
     Parameter('tol', 1e-3, 'stop when relative changes and residuals are below this',
               1e-8, 0.1),
-    Parameter('max_iter', 60, 'ADMM sweeps per window solve at most (T_out)', 1, 10000),
+    Parameter('max_iter', 300, 'ADMM sweeps per window solve at most (T_out) in batch mode',
+              1, 10000),
+    Parameter('stream_max_iter', 5, 'ADMM sweeps per window solve while streaming (node, '
+              'stream mode): each solve starts from the last, so sweeps add up over '
+              'overlapping windows', 1, 10000),
     # Masks.
     Parameter('mask_threshold', 0.0, 'fixed threshold on |S| for data in [0, 1]; 0 = auto '
               '(max(mask_min_threshold, mask_k * robust sigma of D - L))', 0.0, 1.0),
@@ -126,8 +130,8 @@ def check_value(name, value):
         raise ValueError(f'{name} must be in [{spec.low}, {spec.high}], got {value!r}')
 
 
-def build_model(values):
-    """Return the :class:`DualGraphMOD` the values describe."""
+def build_model(values, streaming=False):
+    """Return the :class:`DualGraphMOD` the values describe (for streaming or batch)."""
     return DualGraphMOD(
         lambda1=_auto(values['lambda1']), lambda2=values['lambda2'],
         gamma1=values['gamma1'], gamma2=values['gamma2'], rho1=values['rho1'],
@@ -135,7 +139,8 @@ def build_model(values):
         h_s=_auto(values['h_s']), h_t=_auto(values['h_t']), patch_size=values['patch_size'],
         smoothing_sigma=values['smoothing_sigma'],
         temporal_neighbors=values['temporal_neighbors'], l_step=values['l_step'],
-        inner_iter=values['inner_iter'], tol=values['tol'], max_iter=values['max_iter'])
+        inner_iter=values['inner_iter'], tol=values['tol'],
+        max_iter=values['stream_max_iter' if streaming else 'max_iter'])
 
 
 def build_mask_rule(values):
@@ -152,11 +157,11 @@ COMPARATORS = {'lago': LAGO, 'spcp': SplitSPCP, 'spgl1': SPGL1RPCA, 'ialm': Inex
                'frpcag': FRPCAG, 'median': TemporalMedian}
 
 
-def window_model(values):
+def window_model(values, streaming=False):
     """Return the estimator that separates one window by ``values['method']``."""
     method = values['method']
     if method == 'dgmod':
-        return build_model(values)
+        return build_model(values, streaming)
     if method in ONLINE_METHODS:
         return OpenCVWindowModel(method)
     if method not in COMPARATORS:
@@ -169,7 +174,7 @@ def detector_settings(values):
     if values['method'] in ONLINE_METHODS:
         return {'kind': values['method'], 'scale': values['scale'], 'color': values['color'],
                 'morph_size': values['morph_size']}
-    return {'model': window_model(values), 'window': values['window'],
+    return {'model': window_model(values, streaming=True), 'window': values['window'],
             'stride': values['stride'], 'scale': values['scale'], 'color': values['color'],
             'mask_rule': build_mask_rule(values),
             'motion_threshold': values['motion_threshold'],

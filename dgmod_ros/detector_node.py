@@ -162,6 +162,8 @@ class DetectorNode(Node):
             self._publish_background(model, header)
 
     def _on_solve_error(self, snapshot, error):
+        if not self.context.ok():
+            return      # shutting down: a solve that ends now has nowhere to go
         self._stats.failed(str(error))
         if snapshot is not None:
             with self._lock:

@@ -12,7 +12,8 @@ class SolveWorker:
     There is no queue: :meth:`submit` refuses a job while another runs, so a
     burst of frames can never pile up solves; the caller simply submits the
     next snapshot when the next solve is due. ``on_done(job, result)`` or
-    ``on_error(job, exception)`` run in the worker thread.
+    ``on_error(job, exception)`` run in the worker thread; an exception in
+    ``on_done`` goes to ``on_error`` too.
     """
 
     def __init__(self, solve, on_done, on_error, name='dgmod-solver'):
@@ -63,11 +64,9 @@ class SolveWorker:
                     return
                 job, self._job = self._job, None
             try:
-                result = self._solve(job)
+                self._on_done(job, self._solve(job))
             except Exception as error:  # noqa: B902 - reported, never kills the thread
                 self._on_error(job, error)
-            else:
-                self._on_done(job, result)
             finally:
                 with self._condition:
                     self._busy = False

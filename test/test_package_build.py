@@ -104,4 +104,4 @@ def test_installed_detector_masks_frames_and_stops_cleanly(install, monkeypatch,
     assert 'detector ready' in output
     assert process.returncode == 0, output
     assert 'Traceback' not in output, output
-    assert stopped < 2.0, f'shutdown took {stopped:.2f} s'
+    assert stopped < 1.0, f'shutdown took {stopped:.2f} s'

@@ -28,7 +28,7 @@ class ADMMState:
 
     @property
     def frames(self):
-        """Return the number of frames (columns) the state describes."""
+        """Return how many frames the state spans."""
         return self.background.shape[1]
 
     def shifted(self, count, fill_column=None):

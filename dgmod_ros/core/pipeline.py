@@ -106,7 +106,7 @@ def batch_separate(frames, model, window=60, scale=0.5, color='gray', mask_rule=
         record = SolveRecord(first=start, last=stop - 1, iterations=iterations,
                              seconds=time.perf_counter() - started)
         magnitude = np.max(magnitudes, axis=0)
-        threshold = rule.estimate_threshold(np.stack(residuals))
+        threshold = rule.estimate_threshold(np.stack(residuals), np.moveaxis(data, 1, 0))
         mean_background = np.stack(backgrounds, axis=1).reshape(rows, cols, -1)
         for index in range(first_new, stop):
             mask = rule.apply(magnitude[:, index - start].reshape(rows, cols), threshold,

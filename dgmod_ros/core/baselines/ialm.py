@@ -4,9 +4,9 @@
 
 import numpy as np
 
-from ..linalg import shrink
 from .lago import _checked
 from .proximal import singular_value_threshold
+from ..linalg import shrink
 
 
 class InexactALM:

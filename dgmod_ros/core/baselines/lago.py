@@ -4,8 +4,8 @@
 
 import numpy as np
 
-from ..linalg import shrink
 from .proximal import quasi_newton_sls, singular_value_threshold
+from ..linalg import shrink
 
 
 class LAGO:

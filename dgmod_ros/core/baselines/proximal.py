@@ -48,12 +48,26 @@ def project_nuclear_ball(matrix, radius):
 
 
 def project_l1_ball(matrix, radius):
-    """Project onto ``{||X||_1 <= radius}`` (sort-based, Duchi et al. 2008)."""
+    """
+    Project onto ``{||X||_1 <= radius}``.
+
+    The soft threshold ``theta`` solves ``sum(max(|x| - theta, 0)) = radius``;
+    Michelot's fixed point ``theta <- (sum_{|x| > theta} |x| - radius) / #{|x| > theta}``
+    reaches it from below in a few vectorised passes (no sort of all n m
+    entries, which cost 40 ms a call on a 19200 x 30 window).
+    """
     magnitude = np.abs(matrix).ravel()
-    if magnitude.sum() <= radius:
+    total = float(magnitude.sum(dtype=np.float64))
+    if total <= radius:
         return matrix.copy()
-    projected = project_simplex_budget(magnitude, radius)
-    theta = float(np.max(magnitude - projected))
+    active = magnitude
+    theta = (total - radius) / magnitude.size
+    for _ in range(100):
+        active = active[active > theta]
+        new_theta = (float(active.sum(dtype=np.float64)) - radius) / active.size
+        if new_theta <= theta * (1 + 1e-12):
+            break
+        theta = new_theta
     return shrink(matrix, theta)
 
 

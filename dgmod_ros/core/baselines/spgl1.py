@@ -6,9 +6,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..linalg import drop_oldest
 from .lago import _checked
 from .proximal import project_l1_ball, project_nuclear_ball, quasi_newton_sls
+from ..linalg import drop_oldest
 
 
 @dataclass
@@ -20,7 +20,7 @@ class LevelState:
 
     @property
     def frames(self):
-        """Return the number of frames (columns)."""
+        """Return how many frames the state spans."""
         return self.background.shape[1]
 
     def shifted(self, count):

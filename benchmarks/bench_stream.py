@@ -1,0 +1,58 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""
+Frames per second of ``dgmod separate`` in stream mode on 300 frames of 320 x 240.
+
+Two inputs: the synthetic scene written as PNG files to a temporary folder, and
+frames 470-769 of CDnet highway (JPEG) when ../shared/data is present. The
+figure is report.json's ``fps`` (decoding, separation and writing included).
+
+Usage (repo root): PYTHONPATH=. python benchmarks/bench_stream.py [--method dgmod]
+"""
+
+import argparse
+import json
+from pathlib import Path
+import shutil
+import tempfile
+
+import cv2
+from dgmod_ros import cli
+from dgmod_ros.core.synthetic import synthetic_scene
+
+HIGHWAY = Path(__file__).resolve().parents[2] / 'shared' / 'data' / 'cdnet_highway' / 'input'
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
+    parser.add_argument('--method', default='dgmod')
+    args, extra = parser.parse_known_args(argv)
+    work = Path(tempfile.mkdtemp(prefix='dgmod_bench_'))
+    try:
+        synthetic = work / 'synthetic'
+        synthetic.mkdir()
+        for index, frame in enumerate(synthetic_scene(n_frames=300, shape=(240, 320)).frames):
+            bgr = cv2.cvtColor(frame, cv2.COLOR_RGB2BGR)
+            cv2.imwrite(str(synthetic / f'{index:06d}.png'), bgr)
+        inputs = {'synthetic 320x240 PNG': synthetic}
+        if HIGHWAY.is_dir():
+            highway = work / 'highway'
+            highway.mkdir()
+            for path in sorted(HIGHWAY.iterdir())[469:769]:
+                shutil.copy(path, highway / path.name)
+            inputs['CDnet highway 470-769 JPEG'] = highway
+        for name, folder in inputs.items():
+            out = work / f'out_{folder.name}'
+            cli.main(['separate', str(folder), '--out', str(out), '--method', args.method,
+                      '--quiet'] + extra)
+            report = json.loads((out / 'report.json').read_text())
+            solves = report['windows']
+            median = sorted(w['seconds'] for w in solves)[len(solves) // 2]
+            print(f'{name}: {report["frames"]} frames, {report["fps"]:.1f} frames/s, '
+                  f'{len(solves)} solves, median solve {median:.3f} s')
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+
+if __name__ == '__main__':
+    main()
