@@ -5,7 +5,7 @@ Replay a camera through the detector node and print its real-time figures.
 
 320 x 240 rgb8 frames of the synthetic scene are published at 30 frames/s
 for 60 s to the node (default parameters: window 30, stride 10, half-size
-processing, async solves), spun by a MultiThreadedExecutor as ``main()`` does.
+processing, async solves), spun by a SingleThreadedExecutor as ``main()`` does.
 Printed: frames published / received / masked / dropped, mask latency
 (receipt to publish) p50 and p95, window solves per second, resident memory at
 10 s and at the end. The same run with ``method:=mog2`` (OpenCV MOG2 in the
@@ -25,7 +25,7 @@ from dgmod_ros.detector_node import DetectorNode
 from dgmod_ros.image_conversion import array_to_image_fields
 import rclpy
 from rclpy.context import Context
-from rclpy.executors import MultiThreadedExecutor, SingleThreadedExecutor
+from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile
 from sensor_msgs.msg import Image
@@ -43,7 +43,7 @@ def replay(method, seconds, rate, frames):
     context = Context()
     rclpy.init(context=context)
     node = DetectorNode(context=context, parameter_overrides=[Parameter('method', value=method)])
-    node_executor = MultiThreadedExecutor(num_threads=2, context=context)
+    node_executor = SingleThreadedExecutor(context=context)     # as main() does
     node_executor.add_node(node)
     camera = rclpy.create_node('bench_camera', context=context)
     publisher = camera.create_publisher(Image, 'image', QoSProfile(depth=5))
