@@ -8,7 +8,9 @@ from dgmod_ros.image_conversion import ENCODINGS
 import numpy as np
 import pytest
 from rclpy.parameter import Parameter
+from rclpy.qos import QoSProfile
 from ros_harness import DetectorHarness, image_message, mask_array
+from sensor_msgs.msg import Image
 
 SHAPE = (120, 160)
 
@@ -134,3 +136,18 @@ def test_frame_size_change_restarts_the_window(harness, scene):
     assert figures['window_resets'] == 1
     assert figures['masks_out'] == 30 and figures['solves'] >= 2
     assert harness.node._detector.shape_[:2] == (30, 40)
+
+
+def test_overlay_is_off_by_default_and_published_when_asked(harness, scene):
+    overlays = []
+    harness.client.create_subscription(Image, 'foreground_overlay', overlays.append,
+                                       QoSProfile(depth=100))
+    harness.send(image_message(scene.frames[0], 'rgb8'))
+    assert harness.node._overlay_pub is None
+    assert harness.node.set_parameters([Parameter('publish_overlay', value=True)])[0].successful
+    harness.spin_until(lambda: harness.node._overlay_pub.get_subscription_count() > 0)
+    for frame in scene.frames[1:4]:
+        harness.send(image_message(frame, 'rgb8'))
+    assert harness.spin_until(lambda: len(overlays) == 3)
+    overlay = mask_array(overlays[-1])
+    assert overlays[-1].encoding == 'rgb8' and overlay.shape == SHAPE + (3,)

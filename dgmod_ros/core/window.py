@@ -18,6 +18,7 @@ solve in a worker thread; :meth:`process` does all three in line.
 
 from collections import deque
 from dataclasses import dataclass, field
+import inspect
 import time
 
 import numpy as np
@@ -214,7 +215,7 @@ class SlidingWindowDetector:
         frames cannot become colour); model and mask parameters take effect at
         the next solve.
         """
-        unknown = set(params) - set(self.__init__.__code__.co_varnames[1:])
+        unknown = set(params) - set(inspect.signature(type(self)).parameters)
         if unknown:
             raise ValueError(f'unknown parameters: {", ".join(sorted(unknown))}')
         old = assign_validated(self, params)
