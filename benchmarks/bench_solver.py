@@ -107,7 +107,7 @@ def main(argv=None):
           f'(per sweep {ref_median / ref.n_iter_ / (fast_median / fast.n_iter_):.1f}x)')
 
     loose_times, loose = timed_fit(lambda: DualGraphMOD(tol=1e-3), data, args.repeats)
-    print(f'fast solver at tol 1e-3 (the node default): median '
+    print(f'fast solver at tol 1e-3 (the node and CLI tolerance): median '
           f'{statistics.median(loose_times):.3f} s ({loose.n_iter_} sweeps), '
           f'F {fmeasure(loose, data, masks):.3f}')
 
