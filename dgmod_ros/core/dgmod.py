@@ -7,7 +7,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .graphs import spatial_laplacian, temporal_laplacian
-from .linalg import drop_oldest, relative_change, shrink
+from .linalg import drop_oldest, relative_change, shrink, singular_value_map
 
 
 @dataclass
@@ -241,16 +241,8 @@ class DualGraphMOD:
             result = (left[:, keep] * shrunk[keep]) @ right_t[keep]
             return result.astype(np.float32), sigma, int(np.count_nonzero(keep))
         # U = Lh B diag(shrunk / sigma) B^T needs only the m x m eigenproblem.
-        gram = (matrix.T @ matrix).astype(np.float64)
-        eigval, eigvec = np.linalg.eigh(gram)
-        eigval = np.clip(eigval[::-1], 0.0, None)
-        eigvec = eigvec[:, ::-1]
-        sigma = np.sqrt(eigval)
-        shrunk = np.maximum(sigma - weights * threshold, 0.0)
-        keep = shrunk > 0
-        ratio = shrunk[keep] / sigma[keep]
-        mixing = (eigvec[:, keep] * ratio) @ eigvec[:, keep].T
-        return matrix @ mixing.astype(np.float32), sigma, int(np.count_nonzero(keep))
+        return singular_value_map(matrix, lambda sigma: np.maximum(
+            sigma - weights[:sigma.size] * threshold, 0.0))
 
     def _l_step(self, rhs, background, ops, c):
         """Minimise the Lagrangian over L: ``g1 Phi_s L + g2 L Phi_t + c L = rhs``."""

@@ -24,6 +24,7 @@ import time
 import numpy as np
 
 from .dgmod import DualGraphMOD
+from .linalg import thin_svd
 from .masks import MaskRule
 from .preprocess import moving_frames, processing_shape, resize, to_float_channels
 
@@ -494,15 +495,9 @@ def assign_validated(target, params):
 
 
 def background_basis(background, max_rank=None):
-    """Orthonormal basis of the dominant column space of a background matrix (n x m)."""
-    gram = (background.T @ background).astype(np.float64)
-    eigval, eigvec = np.linalg.eigh(gram)
-    eigval, eigvec = eigval[::-1], eigvec[:, ::-1]
-    sigma = np.sqrt(np.clip(eigval, 0.0, None))
-    keep = sigma > _BASIS_RTOL * max(sigma[0], np.finfo(np.float64).tiny)
-    if max_rank is not None:
-        keep[max_rank:] = False
-    return (background @ (eigvec[:, keep] / sigma[keep]).astype(np.float32)).astype(np.float32)
+    """Return an orthonormal basis of the dominant column space of a background (n x m)."""
+    left, _, _ = thin_svd(np.asarray(background, dtype=np.float32), max_rank, _BASIS_RTOL)
+    return left
 
 
 def robust_projection(basis, columns):

@@ -4,29 +4,13 @@
 
 import numpy as np
 
-from ..linalg import shrink
-
-
-def singular_value_map(matrix, transform):
-    """
-    Return ``A diag(transform(sigma)) B^T`` for the thin SVD ``A diag(sigma) B^T``.
-
-    Goes through the m x m Gram matrix (``matrix`` is tall). ``transform`` maps
-    the descending singular values to new non-negative ones.
-    """
-    gram = (matrix.T @ matrix).astype(np.float64)
-    eigval, eigvec = np.linalg.eigh(gram)
-    sigma = np.sqrt(np.clip(eigval[::-1], 0.0, None))
-    eigvec = eigvec[:, ::-1]
-    new = np.asarray(transform(sigma), dtype=np.float64)
-    keep = (new > 0) & (sigma > 1e-12 * max(sigma[0], 1e-300))
-    mixing = (eigvec[:, keep] * (new[keep] / sigma[keep])) @ eigvec[:, keep].T
-    return matrix @ mixing.astype(matrix.dtype), int(np.count_nonzero(keep))
+from ..linalg import shrink, singular_value_map
 
 
 def singular_value_threshold(matrix, threshold):
     """Return the prox of ``threshold * ||.||_*`` at ``matrix`` and the rank kept."""
-    return singular_value_map(matrix, lambda s: np.maximum(s - threshold, 0.0))
+    result, _, rank = singular_value_map(matrix, lambda s: np.maximum(s - threshold, 0.0))
+    return result, rank
 
 
 def project_simplex_budget(values, budget):
@@ -44,7 +28,8 @@ def project_simplex_budget(values, budget):
 
 def project_nuclear_ball(matrix, radius):
     """Project onto ``{||X||_* <= radius}``; return the projection and its rank."""
-    return singular_value_map(matrix, lambda s: project_simplex_budget(s, radius))
+    result, _, rank = singular_value_map(matrix, lambda s: project_simplex_budget(s, radius))
+    return result, rank
 
 
 def project_l1_ball(matrix, radius):
