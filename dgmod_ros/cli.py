@@ -21,9 +21,9 @@ import sys
 import time
 
 import cv2
-import numpy as np
 
 from . import config
+from .core.preprocess import to_uint8
 from .core.runtime import keep_freed_memory
 from .evaluation import evaluate
 from .inputs import BadInput, count_frames, read_frames
@@ -157,7 +157,7 @@ def _write_png(path, image):
 
 
 def _background_png(background):
-    pixels = np.clip(np.asarray(background) * 255.0 + 0.5, 0, 255).astype(np.uint8)
+    pixels = to_uint8(background)
     if pixels.ndim == 3 and pixels.shape[2] == 1:
         return pixels[:, :, 0]
     return cv2.cvtColor(pixels, cv2.COLOR_RGB2BGR) if pixels.ndim == 3 else pixels

@@ -20,18 +20,12 @@ import time
 import cv2
 import numpy as np
 
+from .core.masks import overlay
 from .core.metrics import ConfusionCounts, iou, psnr
 from .core.runtime import keep_freed_memory
 from .core.synthetic import synthetic_scene
 from .image_conversion import array_to_image_fields, image_to_array
 from .inputs import BadInput, read_frames
-
-
-def overlay(frame_rgb, mask):
-    """Tint the masked pixels of an RGB frame red."""
-    out = frame_rgb.astype(np.float32)
-    out[mask > 0] = 0.5 * out[mask > 0] + np.array([127.5, 0.0, 0.0])
-    return out.astype(np.uint8)
 
 
 def _load(source):
@@ -135,7 +129,7 @@ def run(source=None, out_dir='out/demo'):
     for stamp, background in backgrounds:
         cv2.imwrite(str(out / 'background' / f'{stems[stamp // 10**9]}.png'), background)
     picks = np.linspace(len(frames) // 5, len(frames) - 1, 5).astype(int)
-    montage = [overlay(frames[i], masks[i]) for i in picks if masks[i] is not None]
+    montage = [overlay(frames[i] / 255.0, masks[i]) for i in picks if masks[i] is not None]
     if montage:
         cv2.imwrite(str(out / 'overlay_montage.png'),
                     cv2.cvtColor(np.concatenate(montage, axis=1), cv2.COLOR_RGB2BGR))

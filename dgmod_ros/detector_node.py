@@ -16,7 +16,6 @@ import time
 
 import cv2
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
-import numpy as np
 from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
                                 SetParametersResult)
 import rclpy
@@ -28,7 +27,8 @@ from rclpy.qos_overriding_options import QoSOverridingOptions
 from sensor_msgs.msg import Image
 
 from . import config
-from .core.preprocess import to_float_channels
+from .core.masks import overlay
+from .core.preprocess import to_float_channels, to_uint8
 from .core.window import SolverFailure
 from .image_conversion import array_to_image_fields, image_to_array, ImageConversionError
 from .solve_worker import SolveWorker
@@ -186,17 +186,14 @@ class DetectorNode(Node):
             self._detector.background_image(), self._detector.input_shape_[::-1]), header)
 
     def _publish_background_image(self, image, header):
-        pixels = np.clip(np.asarray(image) * 255.0 + 0.5, 0, 255).astype(np.uint8)
+        pixels = to_uint8(image)
         if pixels.ndim == 3 and pixels.shape[2] == 1:
             pixels = pixels[:, :, 0]
         encoding = 'mono8' if pixels.ndim == 2 else 'rgb8'
         self._background_pub.publish(_message(array_to_image_fields(pixels, encoding), header))
 
     def _publish_overlay(self, image, order, value_range, mask, header):
-        rgb = to_float_channels(image, order or 'rgb', 'rgb', value_range)
-        tinted = rgb * 255.0
-        tinted[mask > 0] = 0.5 * tinted[mask > 0] + np.array([127.5, 0.0, 0.0])
-        pixels = np.clip(tinted + 0.5, 0, 255).astype(np.uint8)
+        pixels = overlay(to_float_channels(image, order or 'rgb', 'rgb', value_range), mask)
         self._overlay_pub.publish(_message(array_to_image_fields(pixels, 'rgb8'), header))
 
     # ----------------------------------------------------------------- parameters

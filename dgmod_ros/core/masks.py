@@ -25,6 +25,8 @@ thresholding, then an optional morphological opening (speckle) and closing
 import cv2
 import numpy as np
 
+from .preprocess import to_uint8
+
 # Enough samples for a stable median; larger windows are subsampled with a
 # fixed stride so that the estimate is deterministic.
 _MAD_SAMPLES = 200_000
@@ -121,9 +123,20 @@ class MaskRule:
             magnitude = cv2.resize(magnitude, (output_shape[1], output_shape[0]),
                                    interpolation=cv2.INTER_LINEAR)
         mask = np.where(magnitude > threshold, np.uint8(255), np.uint8(0))
-        if self.morph_size > 1:
-            kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE,
-                                               (self.morph_size, self.morph_size))
-            mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, kernel)
-            mask = cv2.morphologyEx(mask, cv2.MORPH_CLOSE, kernel)
+        return clean_mask(mask, self.morph_size)
+
+
+def clean_mask(mask, size):
+    """Open (speckle) then close (holes) a 0/255 mask with a ``size`` ellipse; <= 1 is off."""
+    if size <= 1:
         return mask
+    kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (size, size))
+    mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, kernel)
+    return cv2.morphologyEx(mask, cv2.MORPH_CLOSE, kernel)
+
+
+def overlay(rgb, mask):
+    """Return an RGB image (floats in [0, 1]) as uint8 with the masked pixels tinted red."""
+    tinted = np.array(rgb, dtype=np.float32)
+    tinted[mask > 0] = 0.5 * tinted[mask > 0] + np.array([0.5, 0.0, 0.0], dtype=np.float32)
+    return to_uint8(tinted)

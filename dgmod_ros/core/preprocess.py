@@ -62,6 +62,11 @@ def to_float_channels(image, channel_order='rgb', color='gray', value_range=None
     return np.clip(data, 0.0, 1.0, out=np.ascontiguousarray(data))
 
 
+def to_uint8(image):
+    """Return a [0, 1] float image as uint8 0-255, rounded and clipped."""
+    return np.clip(np.asarray(image) * 255.0 + 0.5, 0, 255).astype(np.uint8)
+
+
 def processing_shape(frame_shape, scale):
     """(rows, cols) of a frame after downscaling by ``scale`` (at least 1 x 1)."""
     if not 0 < scale <= 1:

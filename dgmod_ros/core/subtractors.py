@@ -5,7 +5,8 @@
 import cv2
 import numpy as np
 
-from .preprocess import processing_shape, resize, to_float_channels
+from .masks import clean_mask
+from .preprocess import processing_shape, resize, to_float_channels, to_uint8
 from .window import assign_validated, FrameResult
 
 _FACTORIES = {
@@ -90,18 +91,14 @@ class OpenCVSubtractor:
             self.reset()
         self.input_shape_ = frame.shape[:2]
         small = resize(channels, processing_shape(frame.shape[:2], self.scale))
-        image = np.clip(small * 255.0 + 0.5, 0, 255).astype(np.uint8)
+        image = to_uint8(small)
         if image.ndim == 3 and image.shape[2] == 3:
             image = cv2.cvtColor(image, cv2.COLOR_RGB2BGR)
         raw = self.subtractor_.apply(image)
         mask = np.where(raw == 255, np.uint8(255), np.uint8(0))
         if mask.shape != self.input_shape_:
             mask = cv2.resize(mask, self.input_shape_[::-1], interpolation=cv2.INTER_NEAREST)
-        if self.morph_size > 1:
-            kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE,
-                                               (self.morph_size, self.morph_size))
-            mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, kernel)
-            mask = cv2.morphologyEx(mask, cv2.MORPH_CLOSE, kernel)
+        mask = clean_mask(mask, self.morph_size)
         frame_id = self.next_id_
         self.next_id_ += 1
         return FrameResult(mask=mask, magnitude=raw.astype(np.float32) / 255.0,
@@ -147,7 +144,7 @@ class OpenCVWindowModel:
             raise ValueError(f"kind must be 'mog2' or 'knn', got {self.kind!r}")
         data = np.asarray(data, dtype=np.float32)
         rows, cols = frame_shape
-        frames = np.clip(data * 255.0 + 0.5, 0, 255).astype(np.uint8).T.reshape(-1, rows, cols)
+        frames = to_uint8(data).T.reshape(-1, rows, cols)
         subtractor = _FACTORIES[self.kind]()
         for frame in frames:
             subtractor.apply(frame)
