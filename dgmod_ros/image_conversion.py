@@ -3,6 +3,8 @@
 """
 ``sensor_msgs/Image`` <-> numpy without cv_bridge and without importing ROS.
 
+Also ``sensor_msgs/CompressedImage`` (JPEG, PNG) and depth images to numpy.
+
 Works on any object with the message's fields (``height``, ``width``,
 ``encoding``, ``is_bigendian``, ``step``, ``data``), so it is tested without
 ROS. Rows are read through ``step`` (padding honoured) and multi-byte pixels
@@ -10,6 +12,7 @@ in the byte order ``is_bigendian`` states, as cv_bridge's ``imgmsg_to_cv2``
 does; numpy 2 has no ``ndarray.newbyteorder``, so the dtype carries the order.
 """
 
+import cv2
 import numpy as np
 
 #: encoding -> (numpy dtype, channels, channel order of colour images)
@@ -31,7 +34,8 @@ class ImageConversionError(ValueError):
     A message that cannot be turned into an image.
 
     ``reason`` is a short stable key for counters (``'encoding'``, ``'size'``,
-    ``'step'``, ``'data_length'``, ``'too_large'``, ``'non_finite'``).
+    ``'step'``, ``'data_length'``, ``'too_large'``, ``'non_finite'``, and for
+    compressed images ``'decode'``).
     """
 
     def __init__(self, reason, message):
@@ -39,7 +43,7 @@ class ImageConversionError(ValueError):
         self.reason = reason
 
 
-def image_to_array(msg, max_pixels=None):
+def image_to_array(msg, max_pixels=None, allow_non_finite=False):
     """
     Return the pixels of an Image message as a new ``(h, w)`` or ``(h, w, c)`` array.
 
@@ -49,6 +53,8 @@ def image_to_array(msg, max_pixels=None):
         The message; its buffer is copied, never aliased.
     max_pixels : int or None
         Refuse images with more pixels than this.
+    allow_non_finite : bool
+        Accept NaN and Inf in float images (depth marks "no reading" so).
 
     Returns
     -------
@@ -96,7 +102,7 @@ def image_to_array(msg, max_pixels=None):
     image = image.astype(dtype.newbyteorder('='), copy=True)
     if channels == 1:
         image = image[:, :, 0]
-    if image.dtype.kind == 'f' and not np.all(np.isfinite(image)):
+    if not allow_non_finite and image.dtype.kind == 'f' and not np.all(np.isfinite(image)):
         raise ImageConversionError('non_finite', f'{encoding} image contains NaN or Inf')
     return image, order
 
@@ -117,3 +123,74 @@ def array_to_image_fields(image, encoding):
     return {'height': height, 'width': width, 'encoding': encoding,
             'is_bigendian': int(not np.little_endian),
             'step': width * channels * image.dtype.itemsize, 'data': image.tobytes()}
+
+
+#: Depth encodings (REP 118): 16-bit millimetres or 32-bit float metres.
+DEPTH_ENCODINGS = ('16UC1', 'mono16', '32FC1')
+
+
+def depth_image_to_array(msg, max_pixels=None):
+    """
+    Return a depth Image's pixels: uint16 millimetres or float32 metres (NaN allowed).
+
+    Raises
+    ------
+    ImageConversionError
+        As :func:`image_to_array`; reason ``'encoding'`` for an encoding that
+        is not a depth encoding.
+
+    """
+    if msg.encoding not in DEPTH_ENCODINGS:
+        raise ImageConversionError(
+            'encoding', f'unsupported depth encoding {msg.encoding!r} (supported: '
+                        f'{", ".join(DEPTH_ENCODINGS)})')
+    return image_to_array(msg, max_pixels, allow_non_finite=True)[0]
+
+
+def compressed_image_to_array(msg, max_pixels=None):
+    """
+    Decode a CompressedImage (JPEG or PNG, as image_transport publishes it).
+
+    Parameters
+    ----------
+    msg : sensor_msgs.msg.CompressedImage or any object with ``format`` and ``data``
+        ``format`` is ``'jpeg'``, ``'png'`` or image_transport's
+        ``'<encoding>; jpeg compressed <encoding>'``; the bytes decide.
+    max_pixels : int or None
+        Refuse images with more pixels than this.
+
+    Returns
+    -------
+    image : ndarray (h, w) or (h, w, c)
+        uint8 (or uint16 for a 16-bit PNG); colour in B, G, R(, A) order.
+    channel_order : {'bgr'} or None
+
+    Raises
+    ------
+    ImageConversionError
+        ``'encoding'`` for compressedDepth (its own header, not an image
+        file), ``'data_length'`` for no bytes, ``'decode'`` for bytes OpenCV
+        cannot decode, ``'too_large'``.
+
+    """
+    if 'compresseddepth' in str(msg.format).lower().replace(' ', ''):
+        raise ImageConversionError(
+            'encoding', f'compressedDepth is not supported (format {msg.format!r})')
+    data = msg.data
+    try:
+        raw = np.frombuffer(data, dtype=np.uint8)
+    except TypeError:
+        raw = np.asarray(data, dtype=np.uint8)
+    if raw.size == 0:
+        raise ImageConversionError('data_length', 'compressed image holds no bytes')
+    image = cv2.imdecode(raw, cv2.IMREAD_UNCHANGED)
+    if image is None or image.size == 0:
+        raise ImageConversionError(
+            'decode', f'{raw.size} bytes of format {msg.format!r} are no JPEG or PNG image '
+                      'OpenCV can decode')
+    height, width = image.shape[:2]
+    if max_pixels is not None and height * width > max_pixels:
+        raise ImageConversionError(
+            'too_large', f'{width} x {height} = {width * height} pixels exceeds the limit '
+                         f'of {max_pixels}')
+    return image, ('bgr' if image.ndim == 3 else None)
