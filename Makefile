@@ -6,10 +6,13 @@ STAMP := $(VENV)/.requirements-installed
 
 .PHONY: demo test bench bench-node bench-soak clean
 
-$(STAMP): requirements.txt
+$(STAMP): requirements.txt setup.py
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -r requirements.txt
+	# The package itself, editable (it runs this checkout): .venv/bin/dgmod and
+	# .venv/bin/detector. colcon builds from the same sources into its own prefix.
+	$(PY) -m pip install --quiet -e .
 	touch $(STAMP)
 
 demo: $(STAMP)
@@ -28,4 +31,4 @@ bench-soak: $(STAMP)
 	PYTHONPATH=. $(PY) benchmarks/bench_soak.py
 
 clean:
-	rm -rf $(VENV) out
+	rm -rf $(VENV) out dgmod_ros.egg-info

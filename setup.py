@@ -15,8 +15,14 @@ setup(
         ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
         ('share/' + package_name, ['package.xml']),
         (os.path.join('share', package_name, 'config'), glob('config/*.yaml')),
+        (os.path.join('share', package_name, 'launch'), glob('launch/*.launch.xml')),
     ],
-    install_requires=['setuptools'],
+    # What the code imports at run time, besides ROS 2 (rclpy and the message
+    # packages come from a ROS install, or from the ros-jazzy-* wheels that
+    # requirements.txt pins; they are declared in package.xml). rosbags is for
+    # the offline command's rosbag2 input.
+    install_requires=['setuptools', 'numpy', 'scipy', 'opencv-python-headless', 'PyYAML',
+                      'rosbags'],
     zip_safe=True,
     maintainer='dgmod_ros maintainers',
     maintainer_email='maintainers@dgmod-ros.invalid',

@@ -37,6 +37,7 @@ class Parameter:
     step: int = 1
     choices: tuple = ()
     read_only: bool = False
+    node_only: bool = False     # no meaning offline: the command line has no option for it
 
 
 PARAMETERS = (
@@ -102,14 +103,34 @@ PARAMETERS = (
     Parameter('mask_min_threshold', 0.1, 'floor of the auto threshold', 0.0, 1.0),
     Parameter('morph_size', 3, 'kernel of the morphological opening and closing; 0 = off',
               0, 15),
-    # Node only.
+    # Node only (no command-line option).
     Parameter('solve_mode', 'async', 'async: solves run in a worker thread while frames are '
               'masked; sync: in the image callback (deterministic, for replays)',
-              choices=('async', 'sync')),
+              choices=('async', 'sync'), node_only=True),
     Parameter('max_pixels', 4096 * 4096, 'refuse images with more pixels than this',
-              1, 1 << 30),
-    Parameter('publish_overlay', False, 'publish foreground_overlay (rgb8) for rviz'),
-    Parameter('diagnostics_period', 1.0, 'seconds between /diagnostics messages', 0.1, 60.0),
+              1, 1 << 30, node_only=True),
+    Parameter('publish_overlay', False, 'publish foreground_overlay (rgb8) for rviz',
+              node_only=True),
+    Parameter('diagnostics_period', 1.0, 'seconds between /diagnostics messages', 0.1, 60.0,
+              node_only=True),
+    Parameter('foreground_jump', 0.3, 'diagnostics warn when the foreground share of the '
+              'frame changes by more than this between consecutive frames (camera moved, '
+              'lights); 1.0 disables', 0.01, 1.0, node_only=True),
+    Parameter('input_transport', 'raw', 'raw: subscribe image (sensor_msgs/Image); '
+              'compressed: subscribe image/compressed (sensor_msgs/CompressedImage, JPEG or '
+              'PNG, as image_transport offers it)', choices=('raw', 'compressed'),
+              read_only=True, node_only=True),
+    Parameter('autostart', True, 'configure and activate the lifecycle node at start-up; '
+              'false waits for a lifecycle manager', read_only=True, node_only=True),
+    # Depth (people in 3-D for planners).
+    Parameter('use_depth', False, 'also subscribe depth/image_rect (16UC1 mm or 32FC1 m, '
+              'registered to image) and depth/camera_info, and publish foreground_points and '
+              'foreground_depth/image_rect + camera_info for every paired frame',
+              read_only=True, node_only=True),
+    Parameter('depth_slop', 0.02, 'largest stamp difference (seconds) of a colour frame and '
+              'the depth image paired with it', 0.0, 1.0, node_only=True),
+    Parameter('cloud_pixel_step', 2, 'foreground_points takes every n-th pixel in both '
+              'directions (1 = every foreground pixel)', 1, 16, node_only=True),
 )
 
 BY_NAME = {p.name: p for p in PARAMETERS}
@@ -237,7 +258,8 @@ def load_parameter_file(path):
 
 _SECTIONS = {'method': 'Method and sliding window',
              'lambda1': 'Model (Algorithm 1); 0.0 means automatic where stated',
-             'mask_threshold': 'Masks', 'solve_mode': 'Node'}
+             'mask_threshold': 'Masks', 'solve_mode': 'Node',
+             'use_depth': 'Depth: the foreground in 3-D for planners'}
 
 
 def _yaml_scalar(value):

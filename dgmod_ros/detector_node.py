@@ -11,6 +11,7 @@ after every window solve), optionally ``foreground_overlay`` (rgb8), and
 converts messages, holds parameters and schedules solves.
 """
 
+import sys
 import threading
 import time
 
@@ -20,6 +21,7 @@ from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescr
                                 SetParametersResult)
 import rclpy
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
+from rclpy.exceptions import ParameterException
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import qos_profile_sensor_data, QoSProfile
@@ -273,13 +275,25 @@ class DetectorNode(Node):
 
 
 def main(args=None):
-    """Run the detector until Ctrl-C, SIGTERM or an external shutdown."""
+    """
+    Run the detector until Ctrl-C, SIGTERM or an external shutdown.
+
+    Returns the exit status: 0, or 1 when a parameter given at start-up is
+    invalid (one logged error naming it and the reason, no traceback).
+    """
     # Jazzy's rclpy.init() returns None (the context-manager form arrived after
     # Jazzy), so the context is shut down in a finally block instead.
     rclpy.init(args=args)
     node = None
     try:
-        node = DetectorNode()
+        try:
+            node = DetectorNode()
+        except (ParameterException, ValueError) as error:
+            # Out of range or of the wrong type (rclpy), or against a
+            # cross-field rule (config.validate): the messages name the parameter.
+            rclpy.logging.get_logger('detector').error(
+                f'invalid parameter, detector not started: {error}')
+            return 1
         # The solves run in the node's own thread, so the executor only carries
         # short callbacks. rclpy's MultiThreadedExecutor lost 6-35% of the
         # frames of a 30 frames/s replay here (queue overflow during its
@@ -293,7 +307,8 @@ def main(args=None):
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()
+    return 0
 
 
 if __name__ == '__main__':
-    main()
+    sys.exit(main())
