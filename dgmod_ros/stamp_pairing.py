@@ -57,9 +57,17 @@ class StampPairer:
         """Forget the waiting items and zero the counters."""
         self.primary_ = deque()
         self.secondary_ = deque()
+        self._newest = {}                       # stream -> newest stamp seen
         self.pairs_ = 0
         self.unpaired_primary_ = 0
         self.unpaired_secondary_ = 0
+
+    def clear(self):
+        """Drop the waiting items, counted as unpaired (the inputs started over)."""
+        while self.primary_:
+            self._drop(self.primary_)
+        while self.secondary_:
+            self._drop(self.secondary_)
 
     def add_primary(self, stamp_ns, payload):
         """Add a primary item; return the pairs ``(primary, secondary)`` now complete."""
@@ -70,10 +78,19 @@ class StampPairer:
         return self._add(self.secondary_, stamp_ns, payload)
 
     def _add(self, queue, stamp_ns, payload):
-        if queue and stamp_ns < queue[-1][0]:
-            # Time went back (a bag restarted, a driver reset): nothing
-            # waiting can pair with what comes now.
-            self._drop_all()
+        stream = 'primary' if queue is self.primary_ else 'secondary'
+        newest = self._newest.get(stream)
+        self._newest[stream] = stamp_ns
+        if newest is not None and stamp_ns < newest:
+            # Time went back (a bag restarted, a driver reset): what waits
+            # belongs to the old timeline, except the other stream's items
+            # that already came from the new one.
+            while queue:
+                self._drop(queue)
+            other = self.secondary_ if queue is self.primary_ else self.primary_
+            while other and other[-1][0] > stamp_ns + self.slop_ns:
+                other.pop()
+                self._count_drop(other)
         queue.append((stamp_ns, payload))
         while len(queue) > self.queue_size:
             self._drop(queue)
@@ -81,16 +98,13 @@ class StampPairer:
 
     def _drop(self, queue):
         queue.popleft()
+        self._count_drop(queue)
+
+    def _count_drop(self, queue):
         if queue is self.primary_:
             self.unpaired_primary_ += 1
         else:
             self.unpaired_secondary_ += 1
-
-    def _drop_all(self):
-        while self.primary_:
-            self._drop(self.primary_)
-        while self.secondary_:
-            self._drop(self.secondary_)
 
     def _match(self):
         pairs = []

@@ -66,6 +66,10 @@ def test_a_stalled_stream_bounds_the_queue_and_time_going_back_starts_over():
     assert pairer.unpaired_secondary_ == 1
     assert _feed(pairer, [('c', 0), ('d', 0)]) == [('c0', 'd0')]   # bag restarted
     assert pairer.unpaired_primary_ == 10
+    # Time going back drops what waits from the old timeline on both streams.
+    assert _feed(pairer, [('c', 50), ('d', 52), ('c', 3)]) == []
+    assert [s for s, _ in pairer.primary_] == [3 * MS] and not pairer.secondary_
+    assert pairer.unpaired_primary_ == 11 and pairer.unpaired_secondary_ == 2
 
 
 def test_parameters_are_validated():

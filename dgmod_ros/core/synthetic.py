@@ -101,3 +101,59 @@ def synthetic_scene(n_frames=120, shape=(120, 160), noise=0.01, drift=0.08, seed
         frames[t] = np.clip(grey[:, :, None] * tint * 255.0 + 0.5, 0, 255).astype(np.uint8)
         masks[t] = np.where(shape_mask, 255, 0)
     return SyntheticScene(frames=frames, masks=masks, backgrounds=backgrounds)
+
+
+#: Height of the walking shape in metres: it is drawn as a 1.7 m person.
+PERSON_HEIGHT_M = 1.7
+
+
+@dataclass
+class SyntheticRGBDScene(SyntheticScene):
+    """
+    A :class:`SyntheticScene` with a registered depth image per frame.
+
+    Attributes
+    ----------
+    depth : ndarray (m, h, w) float32
+        Metres: the person at ``body_depth``, the wall behind at
+        ``wall_depth``, NaN where the sensor has no reading.
+    k : list of 9 floats
+        The row-major pinhole matrix of colour and depth (registered), with
+        the focal length that makes the shape 1.7 m tall at ``body_depth``.
+    body_depth, wall_depth : float
+
+    """
+
+    depth: np.ndarray = None
+    k: list = None
+    body_depth: float = 0.0
+    wall_depth: float = 0.0
+
+
+def synthetic_rgbd_scene(n_frames=60, shape=(120, 160), body_depth=2.0, wall_depth=4.0,
+                         invalid_fraction=0.02, seed=0, **scene_options):
+    """
+    Render :func:`synthetic_scene` with a depth camera: a person in front of a wall.
+
+    Parameters
+    ----------
+    n_frames, shape, seed, **scene_options
+        As :func:`synthetic_scene`.
+    body_depth, wall_depth : float
+        Distances in metres along the optical axis (the wall faces the camera).
+    invalid_fraction : float
+        Share of pixels without a depth reading, at random (speckle, as
+        structured-light and stereo sensors have).
+
+    """
+    scene = synthetic_scene(n_frames=n_frames, shape=shape, seed=seed, **scene_options)
+    rows, cols = shape
+    # person_mask spans from 0.62 height above its centre to 0.38 below.
+    focal = 0.55 * rows * body_depth / PERSON_HEIGHT_M
+    depth = np.where(scene.masks > 0, np.float32(body_depth), np.float32(wall_depth))
+    rng = np.random.default_rng(seed + 1)
+    depth[rng.random(depth.shape) < invalid_fraction] = np.nan
+    k = [focal, 0.0, (cols - 1) / 2.0, 0.0, focal, (rows - 1) / 2.0, 0.0, 0.0, 1.0]
+    return SyntheticRGBDScene(frames=scene.frames, masks=scene.masks,
+                              backgrounds=scene.backgrounds, depth=depth.astype(np.float32),
+                              k=k, body_depth=body_depth, wall_depth=wall_depth)
