@@ -3,12 +3,20 @@
 """
 The ``detector`` node: a foreground mask for every camera frame.
 
-Subscribes ``image`` (sensor_msgs/Image, sensor-data QoS) and publishes
+Subscribes ``image`` (sensor_msgs/Image, sensor-data QoS; or
+``image/compressed`` with ``input_transport: compressed``) and publishes
 ``foreground_mask`` (mono8, 0/255, the frame's size and header),
 ``background`` (mono8 or rgb8 at the input size, the newest frame's header,
-after every window solve), optionally ``foreground_overlay`` (rgb8), and
-``/diagnostics``. All numerical work is in :mod:`dgmod_ros.core`; this module
-converts messages, holds parameters and schedules solves.
+after every window solve), optionally ``foreground_overlay`` (rgb8), with
+``use_depth`` the foreground in 3-D (:mod:`dgmod_ros.depth_outputs`), and
+``/diagnostics``. Offers ``~/reset_background`` (std_srvs/Trigger).
+
+A lifecycle node: parameters are declared at construction; configure builds
+the detector, subscriptions and (lifecycle) publishers, activate starts
+masking, deactivate stops it, cleanup releases it all. ``autostart`` (the
+default) configures and activates at once. All numerical work is in
+:mod:`dgmod_ros.core`; this module converts messages, holds parameters and
+schedules solves.
 """
 
 import sys
@@ -17,22 +25,26 @@ import time
 
 import cv2
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+import numpy as np
 from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
                                 SetParametersResult)
 import rclpy
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
 from rclpy.exceptions import ParameterException
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
-from rclpy.node import Node
+from rclpy.lifecycle import LifecycleNode, TransitionCallbackReturn
 from rclpy.qos import qos_profile_sensor_data, QoSProfile
 from rclpy.qos_overriding_options import QoSOverridingOptions
-from sensor_msgs.msg import Image
+from sensor_msgs.msg import CompressedImage, Image
+from std_srvs.srv import Trigger
 
 from . import config
 from .core.masks import overlay
 from .core.preprocess import to_float_channels, to_uint8
 from .core.window import SolverFailure
-from .image_conversion import array_to_image_fields, image_to_array, ImageConversionError
+from .depth_outputs import DepthOutputs
+from .image_conversion import (array_to_image_fields, compressed_image_to_array, image_to_array,
+                               ImageConversionError)
 from .solve_worker import SolveWorker
 from .stats import DetectorStats
 
@@ -63,8 +75,12 @@ def _message(fields, header):
     return msg
 
 
-class DetectorNode(Node):
-    """ROS wiring around :mod:`dgmod_ros.core`'s streaming detector."""
+class StartupError(RuntimeError):
+    """autostart could not configure or activate the node (the reason was logged)."""
+
+
+class DetectorNode(LifecycleNode):
+    """ROS wiring around :mod:`dgmod_ros.core`'s streaming detector, as a lifecycle node."""
 
     def __init__(self, **kwargs):
         super().__init__('detector', **kwargs)
@@ -73,41 +89,139 @@ class DetectorNode(Node):
         self._values = {spec.name: self.get_parameter(spec.name).value
                         for spec in config.PARAMETERS}
         config.validate(self._values)       # a bad parameter file stops the node here
-        self._detector = config.build_detector(self._values)
         self._lock = threading.Lock()       # guards the detector between callbacks
         self._stats = DetectorStats()
+        self._detector = None               # built by configure
+        self._worker = None
+        self._active = False
+        self._lifecycle_state = 'unconfigured'
         self._last_header = None
         self._encoding = None
-        self._worker = SolveWorker(self._solve, self._on_solved, self._on_solve_error)
+        self._frames_ignored = 0
+        self._foreground_share = None
+        self._foreground_jumps = 0
+        self._jump_reported = 0
+        self._subscription = None
+        self._mask_pub = self._background_pub = self._overlay_pub = None
+        self._depth = None
 
         # Separate groups keep the image callback free to run beside the
         # diagnostics timer when the node is composed in a multi-threaded executor.
-        images = MutuallyExclusiveCallbackGroup()
-        timers = MutuallyExclusiveCallbackGroup()
-        self._subscription = self.create_subscription(
-            Image, 'image', self._on_image, qos_profile_sensor_data, callback_group=images,
-            qos_overriding_options=QoSOverridingOptions.with_default_policies())
-        outputs = QoSProfile(depth=5)
-        self._mask_pub = self.create_publisher(Image, 'foreground_mask', outputs)
-        self._background_pub = self.create_publisher(Image, 'background', outputs)
-        self._overlay_pub = None
+        self._image_group = MutuallyExclusiveCallbackGroup()
+        self._timer_group = MutuallyExclusiveCallbackGroup()
+        # Diagnostics report in every lifecycle state, so a plain publisher.
         self._diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 1)
-        self._timer_group = timers
         self._diagnostics_timer = None
         self._apply_node_parameters()
         self.add_on_set_parameters_callback(self._check_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
+        self._reset_service = self.create_service(Trigger, '~/reset_background',
+                                                  self._on_reset_background)
+        if self._values['autostart']:
+            for transition in (self.trigger_configure, self.trigger_activate):
+                if transition() != TransitionCallbackReturn.SUCCESS:
+                    raise StartupError(f'autostart: {transition.__name__} failed')
+
+    # ----------------------------------------------------------------- lifecycle
+    def on_configure(self, state):
+        """Build the detector, the solver thread, subscriptions and publishers."""
+        try:
+            detector = config.build_detector(self._values)
+        except ValueError as error:
+            self.get_logger().error(f'configure failed: {error}')
+            return TransitionCallbackReturn.FAILURE
+        with self._lock:
+            self._detector = detector
+            self._encoding = None
+            self._foreground_share = None
+        self._worker = SolveWorker(self._solve, self._on_solved, self._on_solve_error)
+        sensor_qos = {'callback_group': self._image_group, 'qos_overriding_options':
+                      QoSOverridingOptions.with_default_policies()}
+        if self._values['input_transport'] == 'compressed':
+            self._subscription = self.create_subscription(
+                CompressedImage, 'image/compressed', self._on_compressed_image,
+                qos_profile_sensor_data, **sensor_qos)
+        else:
+            self._subscription = self.create_subscription(
+                Image, 'image', self._on_image, qos_profile_sensor_data, **sensor_qos)
+        outputs = QoSProfile(depth=5)
+        self._mask_pub = self.create_lifecycle_publisher(Image, 'foreground_mask', outputs)
+        self._background_pub = self.create_lifecycle_publisher(Image, 'background', outputs)
+        if self._values['use_depth']:
+            self._depth = DepthOutputs(self, self._values, self._image_group)
+        self._apply_node_parameters()
+        self._lifecycle_state = 'inactive'
         self.get_logger().info(
-            f"detector ready: method {self._values['method']}, window "
+            f"detector configured: method {self._values['method']}, window "
             f"{self._values['window']}, stride {self._values['stride']}, scale "
-            f"{self._values['scale']}, solve_mode {self._values['solve_mode']}")
+            f"{self._values['scale']}, solve_mode {self._values['solve_mode']}, input "
+            f"{self._subscription.topic_name} ({self._values['input_transport']}), depth "
+            f"{'on' if self._depth else 'off'}")
+        return TransitionCallbackReturn.SUCCESS
+
+    def on_activate(self, state):
+        """Activate the publishers and start masking frames."""
+        result = super().on_activate(state)
+        if result == TransitionCallbackReturn.SUCCESS:
+            self._active = True
+            self._lifecycle_state = 'active'
+            self.get_logger().info('detector ready: masking frames')
+        return result
+
+    def on_deactivate(self, state):
+        """Stop masking (incoming frames are ignored) and deactivate the publishers."""
+        self._active = False
+        self._lifecycle_state = 'inactive'
+        with self._lock:
+            if self._depth is not None:
+                self._depth.reset()
+        return super().on_deactivate(state)
+
+    def on_cleanup(self, state):
+        """Release the detector, the solver thread, subscriptions and publishers."""
+        self._release()
+        self._lifecycle_state = 'unconfigured'
+        return TransitionCallbackReturn.SUCCESS
+
+    def on_shutdown(self, state):
+        """Release everything, from any state."""
+        self._active = False
+        self._release()
+        self._lifecycle_state = 'finalized'
+        return TransitionCallbackReturn.SUCCESS
+
+    def _release(self):
+        if self._worker is not None:
+            self._worker.stop(timeout=1.0)
+            self._worker = None
+        if self._subscription is not None:
+            self.destroy_subscription(self._subscription)
+            self._subscription = None
+        for publisher in (self._mask_pub, self._background_pub, self._overlay_pub):
+            if publisher is not None:
+                self.destroy_lifecycle_publisher(publisher)
+        self._mask_pub = self._background_pub = self._overlay_pub = None
+        if self._depth is not None:
+            self._depth.destroy()
+            self._depth = None
+        with self._lock:
+            self._detector = None
 
     # ----------------------------------------------------------------- frames
     def _on_image(self, msg):
+        self._handle_frame(msg, image_to_array, msg.encoding)
+
+    def _on_compressed_image(self, msg):
+        self._handle_frame(msg, compressed_image_to_array, msg.format)
+
+    def _handle_frame(self, msg, convert, encoding):
+        if not self._active:
+            self._frames_ignored += 1   # inactive: counted apart, never masked
+            return
         received = time.monotonic()
         self._stats.received()
         try:
-            image, order = image_to_array(msg, self._values['max_pixels'])
+            image, order = convert(msg, self._values['max_pixels'])
         except ImageConversionError as error:
             self._stats.drop(error.reason)
             self.get_logger().warning(f'dropped a frame: {error}',
@@ -116,13 +230,13 @@ class DetectorNode(Node):
         value_range = self._values['value_range'] or None
         with self._lock:
             self._last_header = msg.header
-            if self._encoding is not None and msg.encoding != self._encoding:
+            if self._encoding is not None and encoding != self._encoding:
                 # Same size, other meaning (colour to depth, say): restart too.
                 self._detector.reset()
                 self._stats.window_reset()
                 self.get_logger().info(f'encoding changed from {self._encoding} to '
-                                       f'{msg.encoding}: window restarted')
-            self._encoding = msg.encoding
+                                       f'{encoding}: window restarted')
+            self._encoding = encoding
             try:
                 if self._values['solve_mode'] == 'sync':
                     result, solved = self._detector.process(image, order or 'rgb', value_range)
@@ -138,10 +252,13 @@ class DetectorNode(Node):
         self._mask_pub.publish(_message(array_to_image_fields(result.mask, 'mono8'),
                                         msg.header))
         self._stats.masked(time.monotonic() - received)
+        if self._depth is not None:
+            self._depth.add_mask(msg.header, result.mask)
+        self._watch_foreground_share(result.mask)
         if result.reset:
             self._stats.window_reset()
-            self.get_logger().info(f'frame size or encoding changed to {msg.width} x '
-                                   f'{msg.height} {msg.encoding}: window restarted')
+            self.get_logger().info(f'frame size or encoding changed to {image.shape[1]} x '
+                                   f'{image.shape[0]} {encoding}: window restarted')
         if result.solve_error:
             self._on_solve_error(None, SolverFailure(result.solve_error))
         if solved is not None:
@@ -153,12 +270,39 @@ class DetectorNode(Node):
         if self._overlay_pub is not None:
             self._publish_overlay(image, order, value_range, result.mask, msg.header)
 
+    def _watch_foreground_share(self, mask):
+        """Count jumps of the foreground share between consecutive frames."""
+        share = float(np.count_nonzero(mask)) / mask.size
+        previous, self._foreground_share = self._foreground_share, share
+        if previous is not None and abs(share - previous) > self._values['foreground_jump']:
+            self._foreground_jumps += 1
+            self.get_logger().warning(
+                f'foreground share jumped from {previous:.0%} to {share:.0%} of the frame: '
+                'camera moved or lights changed? (~/reset_background restarts the window)',
+                throttle_duration_sec=_WARN_PERIOD)
+
+    def _on_reset_background(self, request, response):
+        with self._lock:
+            if self._detector is None:
+                response.success = False
+                response.message = f'not configured (state {self._lifecycle_state})'
+                return response
+            self._detector.reset()
+            self._foreground_share = None
+        self._stats.window_reset()
+        self.get_logger().info('window restarted on request')
+        response.success = True
+        response.message = 'window restarted: a new background is learnt from the next frames'
+        return response
+
     # ----------------------------------------------------------------- solves
     def _solve(self, snapshot):
         return self._detector.solve(snapshot)
 
     def _on_solved(self, snapshot, model):
         with self._lock:
+            if self._detector is None:
+                return      # cleaned up while the solve ran
             installed = self._detector.install(model)
             header = self._last_header
         if installed:
@@ -166,7 +310,7 @@ class DetectorNode(Node):
             self._publish_background(model, header)
 
     def _on_solve_error(self, snapshot, error):
-        if not self.context.ok():
+        if not self.context.ok() or self._detector is None:
             return      # shutting down: a solve that ends now has nowhere to go
         self._stats.failed(str(error))
         if snapshot is not None:
@@ -176,7 +320,7 @@ class DetectorNode(Node):
                                   throttle_duration_sec=_WARN_PERIOD)
 
     def _publish_background(self, model, header):
-        if header is None:
+        if header is None or self._background_pub is None:
             return
         input_shape = self._detector.input_shape_
         image = cv2.resize(model.background, (input_shape[1], input_shape[0]),
@@ -200,8 +344,9 @@ class DetectorNode(Node):
 
     # ----------------------------------------------------------------- parameters
     def _check_parameters(self, parameters):
+        # Only the table's parameters: configure declares qos_overrides.* too.
         candidate = dict(self._values)
-        candidate.update({p.name: p.value for p in parameters})
+        candidate.update({p.name: p.value for p in parameters if p.name in config.BY_NAME})
         try:
             config.validate(candidate)
         except ValueError as error:
@@ -209,26 +354,35 @@ class DetectorNode(Node):
         return SetParametersResult(successful=True)
 
     def _apply_parameters(self, parameters):
-        changed = {p.name: p.value for p in parameters}
+        changed = {p.name: p.value for p in parameters if p.name in config.BY_NAME}
+        if not changed:
+            return
         values = dict(self._values)
         values.update(changed)
         with self._lock:
-            if (values['method'] in config.ONLINE_METHODS) != \
+            if self._detector is None:
+                pass                # unconfigured: configure builds it from the values
+            elif (values['method'] in config.ONLINE_METHODS) != \
                     (self._values['method'] in config.ONLINE_METHODS):
                 self._detector = config.build_detector(values)
             else:
                 self._detector.configure(**config.detector_settings(values))
+            if self._depth is not None:
+                self._depth.configure(values)
             self._values = values
         self._apply_node_parameters()
         self.get_logger().info('parameters changed: ' + ', '.join(
             f'{name}={value}' for name, value in sorted(changed.items())))
 
     def _apply_node_parameters(self):
-        if self._values['publish_overlay'] and self._overlay_pub is None:
-            self._overlay_pub = self.create_publisher(Image, 'foreground_overlay',
-                                                      QoSProfile(depth=5))
+        configured = self._mask_pub is not None
+        if self._values['publish_overlay'] and configured and self._overlay_pub is None:
+            self._overlay_pub = self.create_lifecycle_publisher(Image, 'foreground_overlay',
+                                                                QoSProfile(depth=5))
+            if self._active:
+                self._overlay_pub.on_activate(None)
         elif not self._values['publish_overlay'] and self._overlay_pub is not None:
-            self.destroy_publisher(self._overlay_pub)
+            self.destroy_lifecycle_publisher(self._overlay_pub)
             self._overlay_pub = None
         period = self._values['diagnostics_period']
         if self._diagnostics_timer is None or \
@@ -242,6 +396,13 @@ class DetectorNode(Node):
     def statistics(self):
         """Return the node's counters and figures as a dict."""
         figures = self._stats.snapshot()
+        figures['lifecycle_state'] = self._lifecycle_state
+        figures['frames_ignored_inactive'] = self._frames_ignored
+        figures['foreground_jumps'] = self._foreground_jumps
+        if self._foreground_share is not None:
+            figures['foreground_share'] = round(self._foreground_share, 4)
+        if self._depth is not None:
+            figures.update(self._depth.statistics())
         with self._lock:
             buffer = getattr(self._detector, 'buffer_', ())
             figures['window_frames'] = len(buffer)
@@ -259,8 +420,20 @@ class DetectorNode(Node):
             problems.append(f"{figures['frames_dropped']} frames dropped")
         if figures['solve_failures']:
             problems.append(f"{figures['solve_failures']} solves failed")
-        if not figures['model_ready'] and self._values['method'] not in config.ONLINE_METHODS:
+        if self._lifecycle_state != 'active':
+            problems.append(f'{self._lifecycle_state}: not masking frames')
+        elif (not figures['model_ready']
+              and self._values['method'] not in config.ONLINE_METHODS):
             problems.append('warming up: no window solved yet')
+        malformed_depth = self._depth.malformed() if self._depth is not None else 0
+        if malformed_depth:
+            problems.append(f'{malformed_depth} malformed depth images or camera infos dropped')
+        jumps = self._foreground_jumps
+        if jumps > self._jump_reported:
+            problems.append(f'foreground share jumped {jumps - self._jump_reported} times '
+                            f'by more than {self._values["foreground_jump"]:.0%} of the frame '
+                            '(camera moved, lights?)')
+            self._jump_reported = jumps
         status.level = DiagnosticStatus.WARN if problems else DiagnosticStatus.OK
         status.message = '; '.join(problems) or 'masks published for every frame'
         status.values = [KeyValue(key=key, value=str(value)) for key, value in figures.items()]
@@ -270,7 +443,8 @@ class DetectorNode(Node):
 
     def destroy_node(self):
         """Stop the solver thread, then the node."""
-        self._worker.stop(timeout=1.0)
+        if self._worker is not None:
+            self._worker.stop(timeout=1.0)
         return super().destroy_node()
 
 
@@ -294,6 +468,8 @@ def main(args=None):
             rclpy.logging.get_logger('detector').error(
                 f'invalid parameter, detector not started: {error}')
             return 1
+        except StartupError:
+            return 1            # the failed transition logged its reason
         # The solves run in the node's own thread, so the executor only carries
         # short callbacks. rclpy's MultiThreadedExecutor lost 6-35% of the
         # frames of a 30 frames/s replay here (queue overflow during its
@@ -303,6 +479,11 @@ def main(args=None):
         executor.spin()
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
+    except Exception:  # noqa: B902 - re-raised unless it is the shutdown race
+        # SIGINT/SIGTERM shut the context down while a callback was
+        # publishing (RCLError: publisher's context is invalid): a normal stop.
+        if rclpy.ok():
+            raise
     finally:
         if node is not None:
             node.destroy_node()

@@ -26,3 +26,38 @@ def write_image_bag(path, frames, topic='/camera/image_raw', encoding='rgb8',
                         data=frame.reshape(-1).view('uint8'))
             writer.write(connection, stamp, store.serialize_cdr(msg, Image.__msgtype__))
     return path
+
+
+def write_message_bag(path, entries, storage='mcap'):
+    """
+    Write rclpy messages as a rosbag2: ``entries`` are ``(topic, message, time_ns)``.
+
+    The messages are serialized by rclpy and written by rosbags, as a
+    recorder would store them.
+    """
+    from rclpy.serialization import serialize_message
+
+    store = get_typestore(Stores.ROS2_JAZZY)
+    plugin = StoragePlugin.MCAP if storage == 'mcap' else StoragePlugin.SQLITE3
+    with Writer(path, version=9, storage_plugin=plugin) as writer:
+        connections = {}
+        for topic, msg, time_ns in entries:
+            if topic not in connections:
+                msgtype = f'{type(msg).__module__.split(".")[0]}/msg/{type(msg).__name__}'
+                connections[topic] = writer.add_connection(topic, msgtype, typestore=store)
+            writer.write(connections[topic], time_ns, serialize_message(msg))
+    return path
+
+
+def read_message_bag(path):
+    """Yield ``(topic, rclpy message)`` from a rosbag2 in recorded order."""
+    from importlib import import_module
+
+    from rclpy.serialization import deserialize_message
+    from rosbags.rosbag2 import Reader
+
+    with Reader(path) as reader:
+        for connection, _, raw in reader.messages():
+            package, _, name = connection.msgtype.split('/')
+            msg_type = getattr(import_module(f'{package}.msg'), name)
+            yield connection.topic, deserialize_message(raw, msg_type)
