@@ -3,9 +3,9 @@
 """Lifecycle transitions, compressed input, the reset service and the jump warning."""
 
 import cv2
-from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from dgmod_ros.core.metrics import iou
 from dgmod_ros.core.synthetic import synthetic_scene
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from lifecycle_msgs.srv import ChangeState, GetState
 import numpy as np
 import pytest
