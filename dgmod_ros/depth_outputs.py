@@ -76,6 +76,7 @@ class DepthOutputs:
         self._camera_info = None
         self._intrinsics = None
         self._pairer = StampPairer(0)
+        self.active = False               # follows the node's activation
         self.configure(values)
         overrides = QoSOverridingOptions.with_default_policies()
         self._subscriptions = [
@@ -100,7 +101,7 @@ class DepthOutputs:
         self._max_pixels = values['max_pixels']
 
     def reset(self):
-        """Forget the frames waiting for a partner (the window was restarted)."""
+        """Drop the items waiting for a partner (the node was deactivated)."""
         self._account(self._pairer.clear)
 
     # ----------------------------------------------------------------- inputs
@@ -120,6 +121,8 @@ class DepthOutputs:
         self._camera_info, self._intrinsics = msg, intrinsics
 
     def _on_depth(self, msg):
+        if not self.active:
+            return                        # as colour frames: ignored while inactive
         self._count('depth_in')
         try:
             depth = depth_image_to_array(msg, self._max_pixels)

@@ -163,6 +163,8 @@ class DetectorNode(LifecycleNode):
         """Activate the publishers and start masking frames."""
         result = super().on_activate(state)
         if result == TransitionCallbackReturn.SUCCESS:
+            if self._depth is not None:
+                self._depth.active = True
             self._active = True
             self._lifecycle_state = 'active'
             self.get_logger().info('detector ready: masking frames')
@@ -174,6 +176,7 @@ class DetectorNode(LifecycleNode):
         self._lifecycle_state = 'inactive'
         with self._lock:
             if self._depth is not None:
+                self._depth.active = False
                 self._depth.reset()
         return super().on_deactivate(state)
 

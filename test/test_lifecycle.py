@@ -41,8 +41,12 @@ def _send_while_inactive(harness, frame):
 
 
 def test_transitions_from_unconfigured_to_finalized(scene):
-    harness = DetectorHarness(autostart=False, solve_mode='sync', window=10, stride=5)
+    harness = DetectorHarness(autostart=False, use_depth=True, solve_mode='sync', window=10,
+                              stride=5)
     node = harness.node
+
+    def outputs():
+        return (node._mask_pub, node._background_pub) + node._depth.publishers
     try:
         assert node.statistics()['lifecycle_state'] == 'unconfigured'
         assert not list(node.subscriptions) and node._mask_pub is None
@@ -52,23 +56,26 @@ def test_transitions_from_unconfigured_to_finalized(scene):
         assert node.trigger_configure() == SUCCESS
         harness.wait_for_connections()
         assert node.statistics()['lifecycle_state'] == 'inactive'
-        assert not node._mask_pub.is_activated
+        assert not any(p.is_activated for p in outputs())
         _send_while_inactive(harness, scene.frames[0])         # ignored, not masked
         assert node.statistics()['frames_in'] == 0 and not harness.masks
 
         assert node.trigger_activate() == SUCCESS
-        assert node._mask_pub.is_activated and node._background_pub.is_activated
+        assert all(p.is_activated for p in outputs())
         for frame in scene.frames[:12]:
             harness.send(image_message(frame, 'rgb8'))
         assert node.statistics()['solves'] >= 1
 
         assert node.trigger_deactivate() == SUCCESS
-        assert not node._mask_pub.is_activated
+        assert not any(p.is_activated for p in outputs())
         _send_while_inactive(harness, scene.frames[12])
         assert len(harness.masks) == 12
 
         assert node.trigger_cleanup() == SUCCESS
         assert not list(node.subscriptions) and node._detector is None
+        published = {p.topic_name for p in node.publishers}
+        assert node._depth is None and '/diagnostics' in published
+        assert not {'/foreground_mask', '/background', '/foreground_points'} & published
         assert node.statistics()['lifecycle_state'] == 'unconfigured'
 
         # The lifecycle services a manager uses (lifecycle_msgs) drive it the same way.
