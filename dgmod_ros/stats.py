@@ -24,6 +24,7 @@ class DetectorStats:
         self.dropped = Counter()
         self.solves = 0
         self.solve_failures = 0
+        self.solves_discarded = 0
         self.resets = 0
         self.last_solve = {}
         self.last_error = ''
@@ -57,6 +58,11 @@ class DetectorStats:
             self.solve_failures += 1
             self.last_error = message
 
+    def discarded(self):
+        """Count one solve whose result came back for a replaced or reconfigured detector."""
+        with self._lock:
+            self.solves_discarded += 1
+
     def window_reset(self):
         """Count one restart of the window (frame size or encoding change)."""
         with self._lock:
@@ -77,6 +83,7 @@ class DetectorStats:
             figures = {'frames_in': self.frames_in, 'masks_out': self.masks_out,
                        'frames_dropped': sum(self.dropped.values()),
                        'solves': self.solves, 'solve_failures': self.solve_failures,
+                       'solves_discarded': self.solves_discarded,
                        'window_resets': self.resets,
                        'mask_latency_p50_ms': 1e3 * p50, 'mask_latency_p95_ms': 1e3 * p95}
             figures.update({f'dropped_{k}': v for k, v in sorted(self.dropped.items())})
