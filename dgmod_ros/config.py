@@ -110,6 +110,9 @@ PARAMETERS = (
               1, 1 << 30),
     Parameter('publish_overlay', False, 'publish foreground_overlay (rgb8) for rviz'),
     Parameter('diagnostics_period', 1.0, 'seconds between /diagnostics messages', 0.1, 60.0),
+    Parameter('solve_timeout', 10.0, 'diagnostics warn when a window solve has been due '
+              'this many seconds with none finished while frames arrive (a frozen '
+              'background); 0 = never', 0.0, 3600.0),
 )
 
 BY_NAME = {p.name: p for p in PARAMETERS}
@@ -156,7 +159,8 @@ _OPENCV_METHODS = ('mog2', 'knn')
 COMPARATORS = {'lago': LAGO, 'spcp': SplitSPCP, 'spgl1': SPGL1RPCA, 'ialm': InexactALM,
                'frpcag': FRPCAG, 'median': TemporalMedian}
 #: Parameters of the node itself: changing them leaves the detector untouched.
-NODE_PARAMETERS = ('solve_mode', 'max_pixels', 'publish_overlay', 'diagnostics_period')
+NODE_PARAMETERS = ('solve_mode', 'max_pixels', 'publish_overlay', 'diagnostics_period',
+                   'solve_timeout')
 
 
 def window_model(values, streaming=False):

@@ -124,10 +124,12 @@ class DetectorNode(Node):
                     result, solved = detector.process(image, order or 'rgb', value_range)
                 else:
                     result, solved = detector.push(image, order or 'rgb', value_range), None
-                    if detector.solve_due() and not self._worker.busy:
-                        # The job names its detector: the result is installed
-                        # only there, and only in the same configuration.
-                        self._worker.submit((detector, detector.snapshot()))
+                    if detector.solve_due():
+                        self._stats.solve_due()
+                        if not self._worker.busy:
+                            # The job names its detector: the result is installed
+                            # only there, and only in the same configuration.
+                            self._worker.submit((detector, detector.snapshot()))
             except ValueError as error:
                 self._stats.drop('invalid')
                 self.get_logger().warning(f'dropped a frame: {error}',
@@ -234,7 +236,8 @@ class DetectorNode(Node):
         figures['worker_callback_errors'] = self._worker.callback_errors
         return figures
 
-    def _publish_diagnostics(self):
+    def diagnostic_status(self):
+        """Return the node's ``DiagnosticStatus``: WARN with the problems, else OK."""
         figures = self.statistics()
         status = DiagnosticStatus(name=f'{self.get_name()}: foreground detection',
                                   hardware_id=self.get_fully_qualified_name())
@@ -245,10 +248,18 @@ class DetectorNode(Node):
             problems.append(f"{figures['solve_failures']} solves failed")
         if not figures['model_ready']:
             problems.append('warming up: no background model yet')
+        timeout = self._values['solve_timeout']
+        if self._stats.solve_overdue(timeout):
+            problems.append(f"no window solve finished for {figures['solve_wait_s']:.0f} s "
+                            f'while frames arrive (solve_timeout {timeout} s): the '
+                            'background is frozen')
         status.level = DiagnosticStatus.WARN if problems else DiagnosticStatus.OK
         status.message = '; '.join(problems) or 'masks published for every frame'
         status.values = [KeyValue(key=key, value=str(value)) for key, value in figures.items()]
-        array = DiagnosticArray(status=[status])
+        return status
+
+    def _publish_diagnostics(self):
+        array = DiagnosticArray(status=[self.diagnostic_status()])
         array.header.stamp = self.get_clock().now().to_msg()
         self._diagnostics_pub.publish(array)
 

@@ -11,6 +11,8 @@ when the test says so.
 import threading
 
 from dgmod_ros.core.synthetic import synthetic_scene
+from dgmod_ros.stats import DetectorStats
+from diagnostic_msgs.msg import DiagnosticStatus
 import pytest
 from rclpy.parameter import Parameter
 from ros_harness import DetectorHarness, image_message
@@ -85,3 +87,31 @@ def test_a_solve_that_ends_after_a_change_is_discarded_and_solving_goes_on(
     figures = harness.node.statistics()
     assert figures['solves'] >= 3 and not harness.node._worker.busy
     assert len(harness.backgrounds) >= 3
+
+
+def test_a_stuck_solve_turns_diagnostics_to_warn_while_frames_arrive(harness, frames):
+    clock = FakeClock()
+    harness.node._stats = DetectorStats(clock=clock)
+    blocking = _start_blocked_solve(harness, frames)
+    assert 'no window solve finished' not in harness.node.diagnostic_status().message
+    for frame in frames[10:22]:                 # a frame a second, the solve stuck
+        clock.now += 1.0
+        _send(harness, frame)
+    status = harness.node.diagnostic_status()
+    assert status.level == DiagnosticStatus.WARN
+    assert 'no window solve finished for 12 s' in status.message
+    blocking.release.set()
+    harness.wait_for_solves()
+    _send(harness, frames[22])                  # the solved background is in use
+    status = harness.node.diagnostic_status()
+    assert status.level == DiagnosticStatus.OK, status.message
+
+
+class FakeClock:
+    """Seconds that move only when the test says so."""
+
+    def __init__(self):
+        self.now = 100.0
+
+    def __call__(self):
+        return self.now
