@@ -6,9 +6,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .lago import _checked
 from .lbfgs import lbfgs
 from ..linalg import drop_oldest, shrink
+from ..window_data import check_window_data
 
 
 @dataclass
@@ -86,7 +86,7 @@ class SplitSPCP:
 
     def fit(self, data, frame_shape, init=None):
         """Separate one window (n pixels x m frames), from ``init`` factors if given."""
-        data = _checked(data, frame_shape).astype(np.float64)
+        data = check_window_data(data, frame_shape).astype(np.float64)
         n, m = data.shape
         k = int(min(self.rank, n, m))
         if k < 1:
