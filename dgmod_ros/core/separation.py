@@ -56,6 +56,7 @@ def separate_channels(model, data, frame_shape, inits=None):
     data : ndarray (C, n, m) float32
         The window, one (pixels x frames) matrix per channel.
     frame_shape : tuple (rows, cols)
+        Size of one frame at the processing size.
     inits : list or None
         Each channel's warm start; None starts every channel cold.
 
