@@ -269,9 +269,9 @@ def main(args=None):
     try:
         node = DetectorNode()
         # The solves run in the node's own thread, so the executor only carries
-        # short callbacks. rclpy's MultiThreadedExecutor lost 6-35% of the
-        # frames of a 30 frames/s replay here (queue overflow during its
-        # stalls; rclpy#1452, #1223); the single-threaded one lost none.
+        # short callbacks. rclpy's MultiThreadedExecutor lost frames of a
+        # 30 frames/s replay here (queue overflow during its stalls; rclpy#1452,
+        # #1223; figures in docs/node.md); the single-threaded one lost none.
         executor = SingleThreadedExecutor()
         executor.add_node(node)
         executor.spin()

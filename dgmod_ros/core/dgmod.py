@@ -72,7 +72,8 @@ class DualGraphMOD:
     ``Phi_s`` and ``Phi_t`` are the normalised Laplacians of the 4-neighbour
     patch-similarity pixel graph and of the nearest-frames graph
     (:mod:`dgmod_ros.core.graphs`). The steps are those of
-    ``docs/algorithm.md``, which corrects the paper's printed S- and V-steps.
+    ``docs/solver.md`` (one ADMM sweep), which corrects the paper's printed S-
+    and V-steps.
 
     Because both the fidelity and the foreground terms are l1, the optimum puts
     the whole residual ``D - L`` into ``S`` when ``lambda2 < 1`` and into
@@ -148,7 +149,7 @@ class DualGraphMOD:
     References
     ----------
     .. [1] J. Qin, R. Shen, R. Zhu, B. Xie, "Robust Dual-Graph Regularized
-       Moving Object Detection", arXiv:2204.11939, 2022 (``shared/paper``).
+       Moving Object Detection", arXiv:2204.11939, 2022.
     .. [2] S. Gu, L. Zhang, W. Zuo, X. Feng, "Weighted Nuclear Norm Minimization
        with Application to Image Denoising", CVPR 2014.
 

@@ -30,7 +30,7 @@ class LAGO:
     tol : float, default=1e-6
         Relative change of ``||L + S - D||_F`` that stops the iteration.
         fastRPCA's default for video-sized problems (1e-3) stops on a
-        high-rank early iterate (``shared/docs/baselines.md`` 3.3).
+        high-rank early iterate (``docs/evaluation.md``).
     max_iter : int, default=200
         fastRPCA's iteration limit for video-sized problems.
 
