@@ -17,8 +17,9 @@ Gaussian noise). When the window's frames are given too, ``sigma`` is at most
 frame differences, which does not depend on how well ``L`` fits: a background
 that lags behind a light change inflates the residual's MAD, never the
 differences' (``docs/solver.md`` has the case that showed it). The magnitude
-is resized to the output size (bilinear) before thresholding, then an optional morphological opening (speckle) and closing
-(holes) with an elliptic ``morph_size x morph_size`` kernel is applied.
+is resized to the output size (bilinear) before thresholding, then an
+optional morphological opening (speckle) and closing (holes) with an elliptic
+``morph_size x morph_size`` kernel is applied.
 """
 
 import cv2
