@@ -27,7 +27,7 @@ from rclpy.qos_overriding_options import QoSOverridingOptions
 from sensor_msgs.msg import CameraInfo, Image, PointCloud2, PointField
 
 from .core.depth import back_project, depth_in_metres, invalidate_background, PinholeIntrinsics
-from .image_conversion import array_to_image_fields, depth_image_to_array, ImageConversionError
+from .image_conversion import depth_image_to_array, fill_image, ImageConversionError
 from .point_cloud import point_cloud_fields
 from .stamp_pairing import StampPairer
 
@@ -146,11 +146,8 @@ class DepthOutputs:
         for mask, (header, encoding, depth, info, intrinsics) in pairs:
             points = back_project(depth_in_metres(depth), mask, intrinsics, self._pixel_step)
             self._points_pub.publish(cloud_message(points, header))
-            masked = Image(header=header)
-            for name, value in array_to_image_fields(invalidate_background(depth, mask),
-                                                     encoding).items():
-                setattr(masked, name, value)
-            self._depth_pub.publish(masked)
+            self._depth_pub.publish(fill_image(Image(), invalidate_background(depth, mask),
+                                               encoding, header))
             info_out = CameraInfo()
             for name in CameraInfo.get_fields_and_field_types():
                 setattr(info_out, name, getattr(info, name))

@@ -23,7 +23,6 @@ import sys
 import threading
 import time
 
-import cv2
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 import numpy as np
 from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
@@ -41,9 +40,9 @@ from std_srvs.srv import Trigger
 from . import config
 from .core.masks import overlay
 from .core.preprocess import to_float_channels, to_uint8
-from .core.window import SolverFailure
+from .core.streaming import SolverFailure
 from .depth_outputs import DepthOutputs
-from .image_conversion import (array_to_image_fields, compressed_image_to_array, image_to_array,
+from .image_conversion import (compressed_image_to_array, fill_image, image_to_array,
                                ImageConversionError)
 from .solve_worker import SolveWorker
 from .stats import DetectorStats
@@ -67,14 +66,6 @@ def _descriptor(spec):
     return descriptor
 
 
-def _message(fields, header):
-    msg = Image()
-    msg.header = header
-    for name, value in fields.items():
-        setattr(msg, name, value)
-    return msg
-
-
 class StartupError(RuntimeError):
     """autostart could not configure or activate the node (the reason was logged)."""
 
@@ -95,7 +86,6 @@ class DetectorNode(LifecycleNode):
         self._worker = None
         self._active = False
         self._lifecycle_state = 'unconfigured'
-        self._last_header = None
         self._encoding = None
         self._frames_ignored = 0
         self._foreground_share = None
@@ -232,7 +222,6 @@ class DetectorNode(LifecycleNode):
             return
         value_range = self._values['value_range'] or None
         with self._lock:
-            self._last_header = msg.header
             if self._encoding is not None and encoding != self._encoding:
                 # Same size, other meaning (colour to depth, say): restart too.
                 self._detector.reset()
@@ -240,20 +229,25 @@ class DetectorNode(LifecycleNode):
                 self.get_logger().info(f'encoding changed from {self._encoding} to '
                                        f'{encoding}: window restarted')
             self._encoding = encoding
+            detector = self._detector
             try:
                 if self._values['solve_mode'] == 'sync':
-                    result, solved = self._detector.process(image, order or 'rgb', value_range)
+                    result, solved = detector.process(image, order or 'rgb', value_range)
                 else:
-                    result, solved = self._detector.push(image, order or 'rgb', value_range), None
-                    if self._detector.solve_due() and not self._worker.busy:
-                        self._worker.submit(self._detector.snapshot())
+                    result, solved = detector.push(image, order or 'rgb', value_range), None
+                    if detector.solve_due():
+                        self._stats.solve_due()
+                        if not self._worker.busy:
+                            # The job names its detector: the result is installed
+                            # only there, and only in the same configuration.
+                            self._worker.submit((detector, detector.snapshot()))
             except ValueError as error:
                 self._stats.drop('invalid')
                 self.get_logger().warning(f'dropped a frame: {error}',
                                           throttle_duration_sec=_WARN_PERIOD)
                 return
-        self._mask_pub.publish(_message(array_to_image_fields(result.mask, 'mono8'),
-                                        msg.header))
+            background = detector.background_image() if result.new_background else None
+        self._mask_pub.publish(fill_image(Image(), result.mask, 'mono8', msg.header))
         self._stats.masked(time.monotonic() - received)
         if self._depth is not None:
             self._depth.add_mask(msg.header, result.mask)
@@ -263,13 +257,11 @@ class DetectorNode(LifecycleNode):
             self.get_logger().info(f'frame size or encoding changed to {image.shape[1]} x '
                                    f'{image.shape[0]} {encoding}: window restarted')
         if result.solve_error:
-            self._on_solve_error(None, SolverFailure(result.solve_error))
+            self._report_solve_error(SolverFailure(result.solve_error))
         if solved is not None:
             self._stats.solved(solved.seconds, solved.iterations, solved.info)
-            self._publish_background(solved, msg.header)
-        elif (self._values['method'] in config.ONLINE_METHODS
-              and result.frame_id % self._values['stride'] == 0):
-            self._publish_opencv_background(msg.header)
+        if background is not None:
+            self._publish_background(background, msg.header)
         if self._overlay_pub is not None:
             self._publish_overlay(image, order, value_range, result.mask, msg.header)
 
@@ -299,51 +291,47 @@ class DetectorNode(LifecycleNode):
         return response
 
     # ----------------------------------------------------------------- solves
-    def _solve(self, snapshot):
-        return self._detector.solve(snapshot)
+    @staticmethod
+    def _solve(job):
+        detector, snapshot = job
+        return detector.solve(snapshot)
 
-    def _on_solved(self, snapshot, model):
+    def _on_solved(self, job, model):
         with self._lock:
             if self._detector is None:
                 return      # cleaned up while the solve ran
             installed = self._detector.install(model)
-            header = self._last_header
         if installed:
+            # The background is published with the next frame (new_background).
             self._stats.solved(model.seconds, model.iterations, model.info)
-            self._publish_background(model, header)
+        else:
+            self._stats.discarded()
 
-    def _on_solve_error(self, snapshot, error):
-        if not self.context.ok() or self._detector is None:
+    def _on_solve_error(self, job, error):
+        if not self.context.ok():
             return      # shutting down: a solve that ends now has nowhere to go
+        detector, _ = job
+        with self._lock:
+            detector.drop_warm_start()      # the detector that started it, if still running
+        self._report_solve_error(error)
+
+    def _report_solve_error(self, error):
         self._stats.failed(str(error))
-        if snapshot is not None:
-            with self._lock:
-                self._detector.drop_warm_start()
         self.get_logger().warning(f'window solve failed, previous background kept: {error}',
                                   throttle_duration_sec=_WARN_PERIOD)
 
-    def _publish_background(self, model, header):
-        if header is None or self._background_pub is None:
+    def _publish_background(self, image, header):
+        if self._background_pub is None:
             return
-        input_shape = self._detector.input_shape_
-        image = cv2.resize(model.background, (input_shape[1], input_shape[0]),
-                           interpolation=cv2.INTER_LINEAR)
-        self._publish_background_image(image, header)
-
-    def _publish_opencv_background(self, header):
-        self._publish_background_image(cv2.resize(
-            self._detector.background_image(), self._detector.input_shape_[::-1]), header)
-
-    def _publish_background_image(self, image, header):
         pixels = to_uint8(image)
-        if pixels.ndim == 3 and pixels.shape[2] == 1:
+        if pixels.shape[2] == 1:
             pixels = pixels[:, :, 0]
         encoding = 'mono8' if pixels.ndim == 2 else 'rgb8'
-        self._background_pub.publish(_message(array_to_image_fields(pixels, encoding), header))
+        self._background_pub.publish(fill_image(Image(), pixels, encoding, header))
 
     def _publish_overlay(self, image, order, value_range, mask, header):
         pixels = overlay(to_float_channels(image, order or 'rgb', 'rgb', value_range), mask)
-        self._overlay_pub.publish(_message(array_to_image_fields(pixels, 'rgb8'), header))
+        self._overlay_pub.publish(fill_image(Image(), pixels, 'rgb8', header))
 
     # ----------------------------------------------------------------- parameters
     def _check_parameters(self, parameters):
@@ -363,13 +351,8 @@ class DetectorNode(LifecycleNode):
         values = dict(self._values)
         values.update(changed)
         with self._lock:
-            if self._detector is None:
-                pass                # unconfigured: configure builds it from the values
-            elif (values['method'] in config.ONLINE_METHODS) != \
-                    (self._values['method'] in config.ONLINE_METHODS):
-                self._detector = config.build_detector(values)
-            else:
-                self._detector.configure(**config.detector_settings(values))
+            if self._detector is not None:     # unconfigured: configure builds it
+                self._detector = config.update_detector(self._detector, values, self._values)
             if self._depth is not None:
                 self._depth.configure(values)
             self._values = values
@@ -407,14 +390,16 @@ class DetectorNode(LifecycleNode):
         if self._depth is not None:
             figures.update(self._depth.statistics())
         with self._lock:
-            buffer = getattr(self._detector, 'buffer_', ())
-            figures['window_frames'] = len(buffer)
-            figures['model_ready'] = getattr(self._detector, 'background_model_',
-                                             None) is not None
-            figures['scene_changes'] = getattr(self._detector, 'scene_changes_', 0)
+            if self._detector is not None:
+                figures.update(self._detector.status())
+            else:
+                figures.update(window_frames=0, model_ready=False)
+        if self._worker is not None:
+            figures['worker_callback_errors'] = self._worker.callback_errors
         return figures
 
-    def _publish_diagnostics(self):
+    def diagnostic_status(self):
+        """Return the node's ``DiagnosticStatus``: WARN with the problems, else OK."""
         figures = self.statistics()
         status = DiagnosticStatus(name=f'{self.get_name()}: foreground detection',
                                   hardware_id=self.get_fully_qualified_name())
@@ -425,9 +410,13 @@ class DetectorNode(LifecycleNode):
             problems.append(f"{figures['solve_failures']} solves failed")
         if self._lifecycle_state != 'active':
             problems.append(f'{self._lifecycle_state}: not masking frames')
-        elif (not figures['model_ready']
-              and self._values['method'] not in config.ONLINE_METHODS):
-            problems.append('warming up: no window solved yet')
+        elif not figures['model_ready']:
+            problems.append('warming up: no background model yet')
+        timeout = self._values['solve_timeout']
+        if self._stats.solve_overdue(timeout):
+            problems.append(f"no window solve finished for {figures['solve_wait_s']:.0f} s "
+                            f'while frames arrive (solve_timeout {timeout} s): the '
+                            'background is frozen')
         malformed_depth = self._depth.malformed() if self._depth is not None else 0
         if malformed_depth:
             problems.append(f'{malformed_depth} malformed depth images or camera infos dropped')
@@ -440,7 +429,10 @@ class DetectorNode(LifecycleNode):
         status.level = DiagnosticStatus.WARN if problems else DiagnosticStatus.OK
         status.message = '; '.join(problems) or 'masks published for every frame'
         status.values = [KeyValue(key=key, value=str(value)) for key, value in figures.items()]
-        array = DiagnosticArray(status=[status])
+        return status
+
+    def _publish_diagnostics(self):
+        array = DiagnosticArray(status=[self.diagnostic_status()])
         array.header.stamp = self.get_clock().now().to_msg()
         self._diagnostics_pub.publish(array)
 
@@ -474,9 +466,9 @@ def main(args=None):
         except StartupError:
             return 1            # the failed transition logged its reason
         # The solves run in the node's own thread, so the executor only carries
-        # short callbacks. rclpy's MultiThreadedExecutor lost 6-35% of the
-        # frames of a 30 frames/s replay here (queue overflow during its
-        # stalls; rclpy#1452, #1223); the single-threaded one lost none.
+        # short callbacks. rclpy's MultiThreadedExecutor lost frames of a
+        # 30 frames/s replay here (queue overflow during its stalls; rclpy#1452,
+        # #1223; figures in docs/node.md); the single-threaded one lost none.
         executor = SingleThreadedExecutor()
         executor.add_node(node)
         executor.spin()

@@ -125,6 +125,32 @@ def array_to_image_fields(image, encoding):
             'step': width * channels * image.dtype.itemsize, 'data': image.tobytes()}
 
 
+def fill_image(msg, image, encoding, header=None):
+    """
+    Fill an Image message (or any object with its fields) from an array; return it.
+
+    The one place that builds ``sensor_msgs/Image`` messages: the node's
+    outputs, the demo's camera, the benchmarks and the tests all use it.
+
+    Parameters
+    ----------
+    msg : sensor_msgs.msg.Image
+        A new message; its pixel fields are replaced.
+    image : ndarray
+        Pixels with the dtype and channel count of ``encoding``.
+    encoding : str
+        One of :data:`ENCODINGS`.
+    header : std_msgs.msg.Header or None
+        Copied into the message when given.
+
+    """
+    for name, value in array_to_image_fields(image, encoding).items():
+        setattr(msg, name, value)
+    if header is not None:
+        msg.header = header
+    return msg
+
+
 #: Depth encodings (REP 118): 16-bit millimetres or 32-bit float metres.
 DEPTH_ENCODINGS = ('16UC1', 'mono16', '32FC1')
 

@@ -5,7 +5,7 @@
 import time
 
 from dgmod_ros.detector_node import DetectorNode
-from dgmod_ros.image_conversion import array_to_image_fields, image_to_array
+from dgmod_ros.image_conversion import fill_image, image_to_array
 import numpy as np
 import rclpy
 from rclpy.context import Context
@@ -24,10 +24,7 @@ def _stamp(msg, stamp_ns, frame_id):
 
 def image_message(array, encoding, stamp_ns=0, frame_id='camera'):
     """Build a sensor_msgs/Image from an array already in ``encoding``'s layout."""
-    msg = Image()
-    for name, value in array_to_image_fields(array, encoding).items():
-        setattr(msg, name, value)
-    return _stamp(msg, stamp_ns, frame_id)
+    return _stamp(fill_image(Image(), array, encoding), stamp_ns, frame_id)
 
 
 def depth_array(metres, encoding):
@@ -105,16 +102,14 @@ class DetectorHarness:
             self.executor.spin_once(timeout_sec=0.02)
         return condition()
 
-    def send(self, msg, expect_mask=True, timeout=10.0, period=0.0, publisher=None):
+    def send(self, msg, expect_mask=True, timeout=10.0, settle=False, publisher=None):
         """
         Publish one frame and wait for its mask (or for it to be counted as dropped).
 
-        With ``period`` > 0, frames are paced like a camera: this call returns no
-        earlier than ``period`` seconds after the previous one.
+        With ``settle``, also wait until a window solve the frame started has
+        ended, so that what follows does not depend on the machine's speed.
+        ``publisher`` (default: the raw ``image`` one) sends it.
         """
-        if period > 0 and hasattr(self, '_last_send'):
-            self.spin_until(lambda: time.monotonic() >= self._last_send + period, period)
-        self._last_send = time.monotonic()
         before_masks = len(self.masks)
         before = self.node.statistics()
         handled = before['masks_out'] + before['frames_dropped']
@@ -125,6 +120,8 @@ class DetectorHarness:
             ok = self.spin_until(lambda: self.node.statistics()['frames_dropped']
                                  + self.node.statistics()['masks_out'] > handled, timeout)
         assert ok, 'no answer from the detector'
+        if settle:
+            self.wait_for_solves()
         return self.masks[-1] if expect_mask else None
 
     def send_depth(self, msg, expect_cloud=True, timeout=10.0):

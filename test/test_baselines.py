@@ -78,7 +78,7 @@ def test_lago_reproduces_fastrpca_escalator_reference(data_dir):
     video = scipy.io.loadmat(data_dir / 'escalator' / 'escalator_data.mat')['X']
     data = video.astype(np.float32)                      # 20800 x 200, 0..255
     model = LAGO(lambda_l=115.0, lambda_s=0.8, tol=1e-8, max_iter=200).fit(data, (130, 160))
-    # shared/docs/baselines.md 1.7 (float64, exact SVD): objective 5.6661e7 at
+    # fastRPCA's own run (float64, exact SVD): objective 5.6661e7 at
     # 198 iterations, rank 69, nnz(S)/N 0.540, relative residual 4.66e-3.
     # Measured here (float32): 5.6806e7 (+0.26%), rank 70, 0.540, 4.66e-3.
     assert model.objective_ == pytest.approx(5.6661e7, rel=5e-3)

@@ -1,0 +1,66 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""One window solve: a :class:`~.results.WindowSnapshot` in, a background model out."""
+
+import time
+
+import numpy as np
+
+from .fast_path import background_basis
+from .results import BackgroundModel, SolverFailure
+from ..separation import separate_channels
+
+
+def warm_starts(snapshot):
+    """
+    Return each channel's warm start for the snapshot's solve (None: cold).
+
+    The previous solve's states, shifted by the frames the window moved on,
+    when the previous window has the same shape and length and still overlaps.
+    """
+    channels = snapshot.shape[2]
+    previous = snapshot.previous
+    if (previous is None or previous.shape != snapshot.shape or not previous.states
+            or any(s is None for s in previous.states)):
+        return [None] * channels
+    shift = snapshot.first_id - previous.first_id
+    width = snapshot.data.shape[2]
+    if not 0 <= shift < width or previous.states[0].frames != width:
+        return [None] * channels
+    return [state.shifted(shift) for state in previous.states]
+
+
+def solve_window(snapshot):
+    """
+    Separate a snapshot with its own estimator; read nothing else.
+
+    Raises
+    ------
+    SolverFailure
+        When the estimator raises or returns non-finite values.
+
+    """
+    rows, cols, channels = snapshot.shape
+    started = time.perf_counter()
+    try:
+        separated = separate_channels(snapshot.model, snapshot.data, (rows, cols),
+                                      warm_starts(snapshot))
+    except (ValueError, FloatingPointError, np.linalg.LinAlgError) as error:
+        raise SolverFailure(f'window solve failed: {error}') from error
+    backgrounds = separated.backgrounds
+    if separated.diverged or not all(np.all(np.isfinite(b)) for b in backgrounds):
+        raise SolverFailure('window solve produced non-finite values')
+    bases = [background_basis(b, int(snapshot.basis_rank)) for b in backgrounds]
+    basis = np.zeros((channels, rows * cols, max(b.shape[1] for b in bases)), dtype=np.float32)
+    for channel, channel_basis in enumerate(bases):
+        basis[channel, :, :channel_basis.shape[1]] = channel_basis
+    return BackgroundModel(
+        basis=basis,
+        background=np.stack([b[:, -1] for b in backgrounds], axis=1).reshape(
+            rows, cols, channels),
+        mean_background=np.stack([b.mean(axis=1) for b in backgrounds], axis=1).reshape(
+            rows, cols, channels),
+        threshold=separated.threshold(snapshot.mask_rule, snapshot.data),
+        shape=snapshot.shape, first_id=snapshot.first_id, last_id=snapshot.last_id,
+        states=separated.states, seconds=time.perf_counter() - started,
+        iterations=separated.iterations, info=separated.info, ticket=snapshot.ticket)
