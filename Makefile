@@ -4,7 +4,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.requirements-installed
 
-.PHONY: demo test bench bench-node bench-soak clean
+.PHONY: demo test bench bench-node bench-soak bench-depth clean
 
 $(STAMP): requirements.txt setup.py
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -29,6 +29,9 @@ bench-node: $(STAMP)
 
 bench-soak: $(STAMP)
 	PYTHONPATH=. $(PY) benchmarks/bench_soak.py
+
+bench-depth: $(STAMP)
+	PYTHONPATH=. $(PY) benchmarks/bench_depth.py
 
 clean:
 	rm -rf $(VENV) out dgmod_ros.egg-info
