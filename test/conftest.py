@@ -2,6 +2,7 @@
 # Licensed under the Apache License, Version 2.0
 """Shared fixtures: where the real sequences live, and a quiet ROS set-up."""
 
+import multiprocessing
 import os
 from pathlib import Path
 
@@ -10,6 +11,11 @@ import pytest
 # In-process ROS tests must not see other processes' nodes (and vice versa);
 # rclpy reads this at init, so it is set before any test creates a context.
 os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'OFF')
+
+# flake8 lints in a process pool. Forked from a test process whose ROS (DDS)
+# threads ran, its workers crashed (segmentation fault in tokenize) and the pool
+# hung; fresh interpreters do not inherit that state.
+multiprocessing.set_start_method('forkserver', force=True)
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = Path(os.environ.get('DGMOD_DATA', REPO.parent / 'shared' / 'data'))
