@@ -9,6 +9,7 @@ from dgmod_ros.core.baselines.median import TemporalMedian
 from dgmod_ros.core.baselines.proximal import project_l1_ball, project_nuclear_ball
 from dgmod_ros.core.baselines.spcp import SplitSPCP
 from dgmod_ros.core.baselines.spgl1 import SPGL1RPCA
+from dgmod_ros.core.dgmod import DualGraphMOD
 from dgmod_ros.core.subtractors import OpenCVWindowModel
 from dgmod_ros.core.synthetic import textured_background
 import numpy as np
@@ -86,3 +87,27 @@ def test_lago_reproduces_fastrpca_escalator_reference(data_dir):
     assert np.count_nonzero(model.foreground_) / data.size == pytest.approx(0.540, abs=0.01)
     residual = np.linalg.norm(model.background_ + model.foreground_ - data) / np.linalg.norm(data)
     assert residual == pytest.approx(4.66e-3, rel=0.05)
+
+
+@pytest.mark.parametrize('model', [DualGraphMOD(), FRPCAG(), LAGO(), SplitSPCP(), SPGL1RPCA(),
+                                   InexactALM(), TemporalMedian(), OpenCVWindowModel('mog2')],
+                         ids=lambda model: type(model).__name__)
+def test_every_window_method_refuses_bad_windows_the_same_way(model):
+    data = np.full((SHAPE[0] * SHAPE[1], 4), 0.5, np.float32)
+    data[7, 2] = np.nan
+    with pytest.raises(ValueError, match='NaN or Inf'):
+        model.fit(data, SHAPE)
+    with pytest.raises(ValueError, match='does not match'):
+        model.fit(np.zeros((10, 4), np.float32), SHAPE)
+    with pytest.raises(ValueError, match='at least 2 frames'):
+        model.fit(np.zeros((SHAPE[0] * SHAPE[1], 1), np.float32), SHAPE)
+
+
+def test_lambda1_zero_means_automatic_and_frpcag_has_no_nuclear_norm():
+    background, outliers = low_rank_plus_sparse()
+    data = background + outliers
+    automatic = np.sqrt(max(data.shape)) * 0.5
+    for value in (None, 0.0):
+        assert DualGraphMOD(lambda1=value, max_iter=2).fit(data, SHAPE).lambda1_ == \
+            pytest.approx(automatic)
+    assert FRPCAG(max_iter=2).fit(data, SHAPE).lambda1_ == 0.0
