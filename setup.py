@@ -16,7 +16,7 @@ setup(
         ('share/' + package_name, ['package.xml']),
         (os.path.join('share', package_name, 'config'), glob('config/*.yaml')),
     ],
-    install_requires=['setuptools'],
+    install_requires=['setuptools', 'numba'],
     zip_safe=True,
     maintainer='dgmod_ros maintainers',
     maintainer_email='maintainers@dgmod-ros.invalid',
