@@ -68,7 +68,7 @@ def _add_parameter_options(parser):
     group = parser.add_argument_group('model, window and mask parameters (defaults: the '
                                       "node's; see config/detector.yaml)")
     for spec in config.PARAMETERS:
-        if spec.name in ('solve_mode', 'publish_overlay', 'diagnostics_period', 'max_pixels'):
+        if spec.name in config.NODE_PARAMETERS:
             continue
         kind = type(spec.default)
         option = '--' + spec.name.replace('_', '-')

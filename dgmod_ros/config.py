@@ -21,8 +21,8 @@ from .core.baselines.spcp import SplitSPCP
 from .core.baselines.spgl1 import SPGL1RPCA
 from .core.dgmod import DualGraphMOD
 from .core.masks import MaskRule
+from .core.streaming import SlidingWindowDetector
 from .core.subtractors import OpenCVSubtractor, OpenCVWindowModel
-from .core.window import SlidingWindowDetector
 
 
 @dataclass(frozen=True)
@@ -110,6 +110,9 @@ PARAMETERS = (
               1, 1 << 30),
     Parameter('publish_overlay', False, 'publish foreground_overlay (rgb8) for rviz'),
     Parameter('diagnostics_period', 1.0, 'seconds between /diagnostics messages', 0.1, 60.0),
+    Parameter('solve_timeout', 10.0, 'diagnostics warn when a window solve has been due '
+              'this many seconds with none finished while frames arrive (a frozen '
+              'background); 0 = never', 0.0, 3600.0),
 )
 
 BY_NAME = {p.name: p for p in PARAMETERS}
@@ -151,10 +154,13 @@ def build_mask_rule(values):
 
 
 #: Methods that update a per-pixel model with every frame instead of solving windows.
-ONLINE_METHODS = ('mog2', 'knn')
+_OPENCV_METHODS = ('mog2', 'knn')
 #: Window methods other than dgmod, built with their documented defaults.
 COMPARATORS = {'lago': LAGO, 'spcp': SplitSPCP, 'spgl1': SPGL1RPCA, 'ialm': InexactALM,
                'frpcag': FRPCAG, 'median': TemporalMedian}
+#: Parameters of the node itself: changing them leaves the detector untouched.
+NODE_PARAMETERS = ('solve_mode', 'max_pixels', 'publish_overlay', 'diagnostics_period',
+                   'solve_timeout')
 
 
 def window_model(values, streaming=False):
@@ -162,18 +168,23 @@ def window_model(values, streaming=False):
     method = values['method']
     if method == 'dgmod':
         return build_model(values, streaming)
-    if method in ONLINE_METHODS:
+    if method in _OPENCV_METHODS:
         return OpenCVWindowModel(method)
     if method not in COMPARATORS:
         raise ValueError(f'unknown method {method!r}')
     return COMPARATORS[method]()
 
 
+def detector_class(values):
+    """Return the streaming detector class that runs ``values['method']``."""
+    return OpenCVSubtractor if values['method'] in _OPENCV_METHODS else SlidingWindowDetector
+
+
 def detector_settings(values):
     """Return the keyword arguments of the streaming detector the values describe."""
-    if values['method'] in ONLINE_METHODS:
+    if detector_class(values) is OpenCVSubtractor:
         return {'kind': values['method'], 'scale': values['scale'], 'color': values['color'],
-                'morph_size': values['morph_size']}
+                'morph_size': values['morph_size'], 'stride': values['stride']}
     return {'model': window_model(values, streaming=True), 'window': values['window'],
             'stride': values['stride'], 'scale': values['scale'], 'color': values['color'],
             'mask_rule': build_mask_rule(values),
@@ -195,22 +206,33 @@ def validate(values):
         if name not in BY_NAME:
             raise ValueError(f'unknown parameter {name!r}')
         check_value(name, value)
-    settings = detector_settings(values)
-    if values['method'] in ONLINE_METHODS:
-        OpenCVSubtractor(**settings).validate()
-    else:
-        SlidingWindowDetector(**settings).validate()
-        build_model(values).check_parameters()
+    detector_class(values)(**detector_settings(values)).validate()
+    # The model's own checks, for every method (the table holds dgmod's values).
+    build_model(values).check_parameters()
     return values
 
 
 def build_detector(values):
     """Return a validated streaming detector for a complete set of values."""
     validate(values)
-    settings = detector_settings(values)
-    if values['method'] in ONLINE_METHODS:
-        return OpenCVSubtractor(**settings).validate()
-    return SlidingWindowDetector(**settings).validate()
+    return detector_class(values)(**detector_settings(values)).validate()
+
+
+def update_detector(detector, values, previous):
+    """
+    Return the streaming detector for ``values``, given the one running with ``previous``.
+
+    Only node parameters changed: ``detector`` itself, untouched. The method
+    needs another detector class: a new detector. Otherwise ``detector``
+    reconfigured (it keeps what it can, see its ``configure``). Either way a
+    solve started before the change is discarded when it comes back.
+    """
+    if all(values[name] == previous[name] for name in DEFAULTS
+           if name not in NODE_PARAMETERS):
+        return detector
+    if type(detector) is not detector_class(values):
+        return build_detector(values)
+    return detector.configure(**detector_settings(values))
 
 
 def load_parameter_file(path):

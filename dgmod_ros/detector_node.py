@@ -14,7 +14,6 @@ converts messages, holds parameters and schedules solves.
 import threading
 import time
 
-import cv2
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
                                 SetParametersResult)
@@ -29,7 +28,7 @@ from sensor_msgs.msg import Image
 from . import config
 from .core.masks import overlay
 from .core.preprocess import to_float_channels, to_uint8
-from .core.window import SolverFailure
+from .core.streaming import SolverFailure
 from .image_conversion import array_to_image_fields, image_to_array, ImageConversionError
 from .solve_worker import SolveWorker
 from .stats import DetectorStats
@@ -74,7 +73,6 @@ class DetectorNode(Node):
         self._detector = config.build_detector(self._values)
         self._lock = threading.Lock()       # guards the detector between callbacks
         self._stats = DetectorStats()
-        self._last_header = None
         self._encoding = None
         self._worker = SolveWorker(self._solve, self._on_solved, self._on_solve_error)
 
@@ -113,7 +111,6 @@ class DetectorNode(Node):
             return
         value_range = self._values['value_range'] or None
         with self._lock:
-            self._last_header = msg.header
             if self._encoding is not None and msg.encoding != self._encoding:
                 # Same size, other meaning (colour to depth, say): restart too.
                 self._detector.reset()
@@ -121,18 +118,24 @@ class DetectorNode(Node):
                 self.get_logger().info(f'encoding changed from {self._encoding} to '
                                        f'{msg.encoding}: window restarted')
             self._encoding = msg.encoding
+            detector = self._detector
             try:
                 if self._values['solve_mode'] == 'sync':
-                    result, solved = self._detector.process(image, order or 'rgb', value_range)
+                    result, solved = detector.process(image, order or 'rgb', value_range)
                 else:
-                    result, solved = self._detector.push(image, order or 'rgb', value_range), None
-                    if self._detector.solve_due() and not self._worker.busy:
-                        self._worker.submit(self._detector.snapshot())
+                    result, solved = detector.push(image, order or 'rgb', value_range), None
+                    if detector.solve_due():
+                        self._stats.solve_due()
+                        if not self._worker.busy:
+                            # The job names its detector: the result is installed
+                            # only there, and only in the same configuration.
+                            self._worker.submit((detector, detector.snapshot()))
             except ValueError as error:
                 self._stats.drop('invalid')
                 self.get_logger().warning(f'dropped a frame: {error}',
                                           throttle_duration_sec=_WARN_PERIOD)
                 return
+            background = detector.background_image() if result.new_background else None
         self._mask_pub.publish(_message(array_to_image_fields(result.mask, 'mono8'),
                                         msg.header))
         self._stats.masked(time.monotonic() - received)
@@ -141,53 +144,45 @@ class DetectorNode(Node):
             self.get_logger().info(f'frame size or encoding changed to {msg.width} x '
                                    f'{msg.height} {msg.encoding}: window restarted')
         if result.solve_error:
-            self._on_solve_error(None, SolverFailure(result.solve_error))
+            self._report_solve_error(SolverFailure(result.solve_error))
         if solved is not None:
             self._stats.solved(solved.seconds, solved.iterations, solved.info)
-            self._publish_background(solved, msg.header)
-        elif (self._values['method'] in config.ONLINE_METHODS
-              and result.frame_id % self._values['stride'] == 0):
-            self._publish_opencv_background(msg.header)
+        if background is not None:
+            self._publish_background(background, msg.header)
         if self._overlay_pub is not None:
             self._publish_overlay(image, order, value_range, result.mask, msg.header)
 
     # ----------------------------------------------------------------- solves
-    def _solve(self, snapshot):
-        return self._detector.solve(snapshot)
+    @staticmethod
+    def _solve(job):
+        detector, snapshot = job
+        return detector.solve(snapshot)
 
-    def _on_solved(self, snapshot, model):
+    def _on_solved(self, job, model):
         with self._lock:
             installed = self._detector.install(model)
-            header = self._last_header
         if installed:
+            # The background is published with the next frame (new_background).
             self._stats.solved(model.seconds, model.iterations, model.info)
-            self._publish_background(model, header)
+        else:
+            self._stats.discarded()
 
-    def _on_solve_error(self, snapshot, error):
+    def _on_solve_error(self, job, error):
         if not self.context.ok():
             return      # shutting down: a solve that ends now has nowhere to go
+        detector, _ = job
+        with self._lock:
+            detector.drop_warm_start()      # the detector that started it, if still running
+        self._report_solve_error(error)
+
+    def _report_solve_error(self, error):
         self._stats.failed(str(error))
-        if snapshot is not None:
-            with self._lock:
-                self._detector.drop_warm_start()
         self.get_logger().warning(f'window solve failed, previous background kept: {error}',
                                   throttle_duration_sec=_WARN_PERIOD)
 
-    def _publish_background(self, model, header):
-        if header is None:
-            return
-        input_shape = self._detector.input_shape_
-        image = cv2.resize(model.background, (input_shape[1], input_shape[0]),
-                           interpolation=cv2.INTER_LINEAR)
-        self._publish_background_image(image, header)
-
-    def _publish_opencv_background(self, header):
-        self._publish_background_image(cv2.resize(
-            self._detector.background_image(), self._detector.input_shape_[::-1]), header)
-
-    def _publish_background_image(self, image, header):
+    def _publish_background(self, image, header):
         pixels = to_uint8(image)
-        if pixels.ndim == 3 and pixels.shape[2] == 1:
+        if pixels.shape[2] == 1:
             pixels = pixels[:, :, 0]
         encoding = 'mono8' if pixels.ndim == 2 else 'rgb8'
         self._background_pub.publish(_message(array_to_image_fields(pixels, encoding), header))
@@ -211,11 +206,7 @@ class DetectorNode(Node):
         values = dict(self._values)
         values.update(changed)
         with self._lock:
-            if (values['method'] in config.ONLINE_METHODS) != \
-                    (self._values['method'] in config.ONLINE_METHODS):
-                self._detector = config.build_detector(values)
-            else:
-                self._detector.configure(**config.detector_settings(values))
+            self._detector = config.update_detector(self._detector, values, self._values)
             self._values = values
         self._apply_node_parameters()
         self.get_logger().info('parameters changed: ' + ', '.join(
@@ -241,14 +232,12 @@ class DetectorNode(Node):
         """Return the node's counters and figures as a dict."""
         figures = self._stats.snapshot()
         with self._lock:
-            buffer = getattr(self._detector, 'buffer_', ())
-            figures['window_frames'] = len(buffer)
-            figures['model_ready'] = getattr(self._detector, 'background_model_',
-                                             None) is not None
-            figures['scene_changes'] = getattr(self._detector, 'scene_changes_', 0)
+            figures.update(self._detector.status())
+        figures['worker_callback_errors'] = self._worker.callback_errors
         return figures
 
-    def _publish_diagnostics(self):
+    def diagnostic_status(self):
+        """Return the node's ``DiagnosticStatus``: WARN with the problems, else OK."""
         figures = self.statistics()
         status = DiagnosticStatus(name=f'{self.get_name()}: foreground detection',
                                   hardware_id=self.get_fully_qualified_name())
@@ -257,12 +246,20 @@ class DetectorNode(Node):
             problems.append(f"{figures['frames_dropped']} frames dropped")
         if figures['solve_failures']:
             problems.append(f"{figures['solve_failures']} solves failed")
-        if not figures['model_ready'] and self._values['method'] not in config.ONLINE_METHODS:
-            problems.append('warming up: no window solved yet')
+        if not figures['model_ready']:
+            problems.append('warming up: no background model yet')
+        timeout = self._values['solve_timeout']
+        if self._stats.solve_overdue(timeout):
+            problems.append(f"no window solve finished for {figures['solve_wait_s']:.0f} s "
+                            f'while frames arrive (solve_timeout {timeout} s): the '
+                            'background is frozen')
         status.level = DiagnosticStatus.WARN if problems else DiagnosticStatus.OK
         status.message = '; '.join(problems) or 'masks published for every frame'
         status.values = [KeyValue(key=key, value=str(value)) for key, value in figures.items()]
-        array = DiagnosticArray(status=[status])
+        return status
+
+    def _publish_diagnostics(self):
+        array = DiagnosticArray(status=[self.diagnostic_status()])
         array.header.stamp = self.get_clock().now().to_msg()
         self._diagnostics_pub.publish(array)
 

@@ -17,22 +17,21 @@ def stream_results(frames, values):
     """
     Yield ``(frame, mask, background, window)`` the way the node computes them.
 
-    ``background`` (float [0, 1], input size, (h, w, C)) and ``window`` (a
-    dict with ``seconds`` and ``iterations``) are None except at a solve.
+    ``background`` (float [0, 1], input size, (h, w, C)) is given where the
+    detector announces a new one (the node publishes it there), ``window`` (a
+    dict with ``seconds`` and ``iterations``) where a window was solved; both
+    are None elsewhere.
     """
     detector = config.build_detector(values)
     value_range = values['value_range'] or None
-    online = values['method'] in config.ONLINE_METHODS
     for frame in frames:
         result, solved = detector.process(frame.image, frame.channel_order, value_range)
-        background, window = None, None
+        window = None
         if solved is not None:
             window = {'first_frame': solved.first_id, 'last_frame': solved.last_id,
                       'seconds': solved.seconds, 'iterations': solved.iterations,
                       'info': solved.info}
-            background = _at_input_size(solved.background, frame)
-        elif online and result.frame_id % values['stride'] == values['stride'] - 1:
-            background = _at_input_size(detector.background_image(), frame)
+        background = detector.background_image() if result.new_background else None
         yield frame, result.mask, background, window
 
 

@@ -2,29 +2,43 @@
 # Licensed under the Apache License, Version 2.0
 """A single background thread that runs one window solve at a time (no ROS import)."""
 
+import logging
 import threading
+
+_LOG = logging.getLogger(__name__)
 
 
 class SolveWorker:
     """
-    Run ``solve(job)`` in one daemon thread, at most one job at a time.
+    Run ``solve(job)`` in one daemon thread, at most one job at a time; never die.
 
     There is no queue: :meth:`submit` refuses a job while another runs, so a
     burst of frames can never pile up solves; the caller simply submits the
     next snapshot when the next solve is due. ``on_done(job, result)`` or
     ``on_error(job, exception)`` run in the worker thread; an exception in
-    ``on_done`` goes to ``on_error`` too.
+    ``on_done`` goes to ``on_error`` too. An exception raised by ``on_error``
+    itself is logged and counted (:attr:`callback_errors`). Whatever happens,
+    the job ends: :attr:`busy` is cleared and the thread takes the next job
+    (a thread killed by something that is not an ``Exception`` is replaced at
+    the next :meth:`submit`).
     """
 
     def __init__(self, solve, on_done, on_error, name='dgmod-solver'):
         self._solve = solve
         self._on_done = on_done
         self._on_error = on_error
+        self._name = name
         self._condition = threading.Condition()
         self._job = None
         self._busy = False
         self._stopping = False
-        self._thread = threading.Thread(target=self._run, name=name, daemon=True)
+        self.callback_errors = 0
+        self.last_callback_error = ''
+        self._thread = None
+        self._start_thread()
+
+    def _start_thread(self):
+        self._thread = threading.Thread(target=self._run, name=self._name, daemon=True)
         self._thread.start()
 
     @property
@@ -38,6 +52,8 @@ class SolveWorker:
         with self._condition:
             if self._busy or self._stopping:
                 return False
+            if not self._thread.is_alive():
+                self._start_thread()
             self._job = job
             self._busy = True
             self._condition.notify()
@@ -64,10 +80,29 @@ class SolveWorker:
                     return
                 job, self._job = self._job, None
             try:
-                self._on_done(job, self._solve(job))
-            except Exception as error:  # noqa: B902 - reported, never kills the thread
-                self._on_error(job, error)
+                self._run_job(job)
             finally:
                 with self._condition:
                     self._busy = False
                     self._condition.notify_all()
+
+    def _run_job(self, job):
+        try:
+            result = self._solve(job)
+        except Exception as error:  # noqa: B902 - reported, never kills the thread
+            self._report(job, error)
+            return
+        try:
+            self._on_done(job, result)
+        except Exception as error:  # noqa: B902 - likewise
+            self._report(job, error)
+
+    def _report(self, job, error):
+        try:
+            self._on_error(job, error)
+        except Exception as failure:  # noqa: B902 - the last line of defence
+            with self._condition:
+                self.callback_errors += 1
+                self.last_callback_error = f'{type(failure).__name__}: {failure}'
+            _LOG.error('solve error handler raised %r while reporting %r', failure, error,
+                       exc_info=failure)

@@ -55,16 +55,13 @@ class DetectorHarness:
             self.executor.spin_once(timeout_sec=0.02)
         return condition()
 
-    def send(self, msg, expect_mask=True, timeout=10.0, period=0.0):
+    def send(self, msg, expect_mask=True, timeout=10.0, settle=False):
         """
         Publish one frame and wait for its mask (or for it to be counted as dropped).
 
-        With ``period`` > 0, frames are paced like a camera: this call returns no
-        earlier than ``period`` seconds after the previous one.
+        With ``settle``, also wait until a window solve the frame started has
+        ended, so that what follows does not depend on the machine's speed.
         """
-        if period > 0 and hasattr(self, '_last_send'):
-            self.spin_until(lambda: time.monotonic() >= self._last_send + period, period)
-        self._last_send = time.monotonic()
         before_masks = len(self.masks)
         before = self.node.statistics()
         handled = before['masks_out'] + before['frames_dropped']
@@ -75,6 +72,8 @@ class DetectorHarness:
             ok = self.spin_until(lambda: self.node.statistics()['frames_dropped']
                                  + self.node.statistics()['masks_out'] > handled, timeout)
         assert ok, 'no answer from the detector'
+        if settle:
+            self.wait_for_solves()
         return self.masks[-1] if expect_mask else None
 
     def wait_for_solves(self, timeout=30.0):

@@ -38,7 +38,7 @@ def test_batch_refuses_mixed_sizes():
 
 
 def test_colour_mode_solves_each_channel_and_fuses():
-    from dgmod_ros.core.window import SlidingWindowDetector
+    from dgmod_ros.core.streaming import SlidingWindowDetector
     scene = synthetic_scene(n_frames=40, shape=(60, 80), seed=2)
     detector = SlidingWindowDetector(window=20, stride=5, color='rgb')
     scores = []

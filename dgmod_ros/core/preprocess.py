@@ -83,6 +83,29 @@ def resize(image, shape, interpolation=cv2.INTER_AREA):
     return out.reshape(shape + image.shape[2:]) if image.ndim == 3 else out
 
 
+def frame_columns(frame, scale, color='gray', channel_order='rgb', value_range=None):
+    """
+    Return one frame as per-channel pixel columns at the processing size.
+
+    The one conversion every window method uses (streaming and batch):
+    :func:`to_float_channels`, then :func:`resize` to :func:`processing_shape`.
+
+    Returns
+    -------
+    columns : ndarray float32 (C, rows * cols)
+        One row per channel, pixels in row-major order.
+    shape : tuple (rows, cols, C)
+
+    """
+    frame = np.asarray(frame)
+    if frame.ndim < 2 or frame.shape[0] == 0 or frame.shape[1] == 0:
+        raise ValueError(f'frame must be a non-empty image, got shape {frame.shape}')
+    channels = to_float_channels(frame, channel_order, color, value_range)
+    rows, cols = processing_shape(channels.shape[:2], scale)
+    small = resize(channels, (rows, cols)).reshape(rows, cols, -1)
+    return small.reshape(rows * cols, -1).T.copy(), (rows, cols, small.shape[2])
+
+
 def moving_frames(columns, threshold):
     """
     Return the indices of the frames kept by the paper's motionless-frame rule.

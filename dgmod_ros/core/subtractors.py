@@ -1,13 +1,15 @@
 # Copyright 2026 dgmod_ros authors
 # Licensed under the Apache License, Version 2.0
-"""OpenCV's per-frame subtractors behind the streaming detector's interface."""
+"""OpenCV's per-frame subtractors: a streaming detector and a window method."""
 
 import cv2
 import numpy as np
 
 from .masks import clean_mask
 from .preprocess import processing_shape, resize, to_float_channels, to_uint8
-from .window import assign_validated, FrameResult
+from .streaming.contract import StreamingDetector
+from .streaming.results import FrameResult, SolverFailure
+from .streaming.settings import assign_validated, check_scale_and_color
 
 _FACTORIES = {
     'mog2': cv2.createBackgroundSubtractorMOG2,
@@ -15,15 +17,16 @@ _FACTORIES = {
 }
 
 
-class OpenCVSubtractor:
+class OpenCVSubtractor(StreamingDetector):
     """
     OpenCV MOG2 or KNN with default settings, as a ROS user would run it.
 
-    Same interface as :class:`~dgmod_ros.core.window.SlidingWindowDetector`
-    (``push``, ``process``, ``solve_due`` is always False), so the node and
-    the command line can run it in the dual-graph model's place. Its output is
-    already a mask: 255 is foreground, 127 (a shadow) is not. The mask is
-    resized to the input size and cleaned with the same morphology as
+    A :class:`~dgmod_ros.core.streaming.contract.StreamingDetector` without
+    window solves: the subtractor updates its model with every frame, so
+    :meth:`solve_due` is always False, :meth:`install` refuses every model and
+    :meth:`drop_warm_start` does nothing. Its output is already a mask: 255 is
+    foreground, 127 (a shadow) is not. The mask is resized to the input size
+    and cleaned with the same morphology as
     :class:`~dgmod_ros.core.masks.MaskRule`.
 
     Parameters
@@ -36,6 +39,10 @@ class OpenCVSubtractor:
         Feed luma or the three colour channels.
     morph_size : int, default=3
         Opening and closing kernel; 0 or 1 disables it.
+    stride : int, default=10
+        Frames between new background images (``FrameResult.new_background``
+        is set on every ``stride``-th frame), as a window method gives one per
+        solve.
 
     References
     ----------
@@ -47,30 +54,30 @@ class OpenCVSubtractor:
 
     """
 
-    def __init__(self, kind='mog2', scale=0.5, color='gray', morph_size=3):
+    def __init__(self, kind='mog2', scale=0.5, color='gray', morph_size=3, stride=10):
         self.kind = kind
         self.scale = scale
         self.color = color
         self.morph_size = morph_size
+        self.stride = stride
 
     def validate(self):
         """Check the parameters; raise ``ValueError`` naming the bad one."""
         if self.kind not in _FACTORIES:
             raise ValueError(f"kind must be 'mog2' or 'knn', got {self.kind!r}")
-        if not (isinstance(self.scale, (int, float)) and 0 < self.scale <= 1):
-            raise ValueError(f'scale must be in (0, 1], got {self.scale!r}')
-        if self.color not in ('gray', 'rgb'):
-            raise ValueError(f"color must be 'gray' or 'rgb', got {self.color!r}")
+        check_scale_and_color(self.scale, self.color)
         if int(self.morph_size) != self.morph_size or self.morph_size < 0:
             raise ValueError(f'morph_size must be a non-negative integer, got {self.morph_size!r}')
+        if int(self.stride) != self.stride or self.stride < 1:
+            raise ValueError(f'stride must be a positive integer, got {self.stride!r}')
         return self
 
     def reset(self):
         """Start a new background model."""
+        self._new_generation()
         self.subtractor_ = _FACTORIES[self.kind]()
         self.input_shape_ = None
         self.next_id_ = 0
-        self.background_model_ = None
 
     def configure(self, **params):
         """Change parameters (validated first); the background model restarts."""
@@ -78,10 +85,13 @@ class OpenCVSubtractor:
         self.reset()
         return self
 
-    def push(self, frame, channel_order='rgb', value_range=None):
-        """Mask one frame; see :meth:`SlidingWindowDetector.push`."""
+    def _ensure_started(self):
         if not hasattr(self, 'subtractor_'):
             self.validate().reset()
+            self.solves_discarded_ = getattr(self, 'solves_discarded_', 0)
+
+    def _ingest(self, frame, channel_order, value_range):
+        self._ensure_started()
         frame = np.asarray(frame)
         if frame.ndim < 2 or frame.shape[0] == 0 or frame.shape[1] == 0:
             raise ValueError(f'frame must be a non-empty image, got shape {frame.shape}')
@@ -95,28 +105,54 @@ class OpenCVSubtractor:
         if image.ndim == 3 and image.shape[2] == 3:
             image = cv2.cvtColor(image, cv2.COLOR_RGB2BGR)
         raw = self.subtractor_.apply(image)
+        frame_id = self.next_id_
+        self.next_id_ += 1
+        return raw, frame_id, reset
+
+    def _finish(self, pending):
+        raw, frame_id, reset = pending
         mask = np.where(raw == 255, np.uint8(255), np.uint8(0))
         if mask.shape != self.input_shape_:
             mask = cv2.resize(mask, self.input_shape_[::-1], interpolation=cv2.INTER_NEAREST)
-        mask = clean_mask(mask, self.morph_size)
-        frame_id = self.next_id_
-        self.next_id_ += 1
-        return FrameResult(mask=mask, magnitude=raw.astype(np.float32) / 255.0,
-                           frame_id=frame_id, buffered=False, reset=reset, model_ready=True)
+        return FrameResult(mask=clean_mask(mask, self.morph_size),
+                           magnitude=raw.astype(np.float32) / 255.0, frame_id=frame_id,
+                           buffered=False, reset=reset, model_ready=True,
+                           new_background=(frame_id + 1) % int(self.stride) == 0)
 
-    def process(self, frame, channel_order='rgb', value_range=None):
-        """Mask one frame; there is never a window solve."""
-        return self.push(frame, channel_order, value_range), None
+    def background_image(self):
+        """Return OpenCV's background image as floats in [0, 1], (h, w, C) at the input size."""
+        if getattr(self, 'input_shape_', None) is None:
+            return None
+        image = self.subtractor_.getBackgroundImage().astype(np.float32) / 255.0
+        image = image[:, :, None] if image.ndim == 2 else image[:, :, ::-1]
+        rows, cols = self.input_shape_
+        return cv2.resize(image, (cols, rows), interpolation=cv2.INTER_LINEAR).reshape(
+            rows, cols, -1)
+
+    def status(self):
+        """Return the subtractor's figures for diagnostics (it has no window)."""
+        self._ensure_started()
+        return {'window_frames': 0, 'model_ready': self.input_shape_ is not None,
+                'scene_changes': 0}
 
     def solve_due(self):
         """Return False: the subtractor updates its model with every frame."""
         return False
 
-    def background_image(self):
-        """Return OpenCV's background image as floats in [0, 1] (rows, cols, C)."""
-        image = self.subtractor_.getBackgroundImage()
-        image = image.astype(np.float32) / 255.0
-        return image[:, :, None] if image.ndim == 2 else image[:, :, ::-1]
+    def snapshot(self):
+        """Refuse: a subtractor has no window to solve."""
+        raise ValueError(f'{self.kind} updates its model with every frame; it has no window '
+                         'to solve')
+
+    def solve(self, snapshot):
+        """Refuse any snapshot: a subtractor solves no windows."""
+        raise SolverFailure(f'{self.kind} solves no windows')
+
+    def drop_warm_start(self):
+        """Do nothing: there is no warm start."""
+
+    def _install(self, model):
+        """Never reached: no snapshot of this detector carries a ticket to install with."""
 
 
 class OpenCVWindowModel:

@@ -1,0 +1,79 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""
+The per-frame fast path: a frame's foreground magnitude from the last window solve.
+
+A frame is projected robustly (iteratively reweighted least squares for an l1
+fit) onto the background subspace of the last solve; the residual is the
+foreground. Before the first solve the per-pixel median of the buffered
+frames is the background.
+"""
+
+import numpy as np
+
+from ..linalg import thin_svd
+
+# IRLS sweeps of the l1 projection; residual changes are below 1e-3 after
+# three on the test scenes.
+_IRLS_SWEEPS = 3
+# Relative singular-value cut-off of the background basis.
+_BASIS_RTOL = 1e-3
+
+
+def background_basis(background, max_rank=None):
+    """Return an orthonormal basis of the dominant column space of a background (n x m)."""
+    left, _, _ = thin_svd(np.asarray(background, dtype=np.float32), max_rank, _BASIS_RTOL)
+    return left
+
+
+def robust_projection(basis, columns):
+    """
+    l1-fit each channel's column onto its basis by IRLS; return the fitted columns.
+
+    Parameters
+    ----------
+    basis : ndarray (C, n, r)
+        Orthonormal background basis of each channel.
+    columns : ndarray (C, n)
+        One frame, one column per channel.
+
+    """
+    fitted = np.empty_like(columns)
+    for channel in range(columns.shape[0]):
+        b, d = basis[channel], columns[channel]
+        coef = b.T @ d
+        for _ in range(_IRLS_SWEEPS):
+            weights = 1.0 / np.maximum(np.abs(d - b @ coef), 1e-3)
+            weighted = b * weights[:, None]
+            coef = np.linalg.lstsq(weighted.T @ b, weighted.T @ d, rcond=None)[0]
+        fitted[channel] = b @ coef
+    return fitted
+
+
+def foreground_magnitude(columns, shape, model, buffered, mask_rule):
+    """
+    Return a frame's foreground magnitude (rows, cols) and the threshold to apply.
+
+    Parameters
+    ----------
+    columns : ndarray (C, n)
+        The frame at the processing size.
+    shape : tuple (rows, cols, C)
+        Processing shape.
+    model : BackgroundModel or None
+        The last installed solve; None while warming up.
+    buffered : ndarray (C, n, m)
+        The buffered frames (used while warming up).
+    mask_rule : MaskRule
+        Estimates the warm-up threshold.
+
+    """
+    rows, cols, _ = shape
+    if model is None:
+        background = np.median(buffered, axis=2)
+        residual = columns - background
+        threshold = mask_rule.estimate_threshold(residual, buffered)
+    else:
+        residual = columns - robust_projection(model.basis, columns)
+        threshold = model.threshold
+    return np.abs(residual).max(axis=0).reshape(rows, cols), threshold

@@ -1,0 +1,125 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""What the streaming detectors hand out: frame results, window snapshots, solved models."""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+class SolverFailure(RuntimeError):
+    """A window solve produced non-finite values or raised; the old model stays."""
+
+
+@dataclass
+class FrameResult:
+    """
+    Outcome of pushing one frame.
+
+    Attributes
+    ----------
+    mask : ndarray uint8 (input rows, input cols)
+        0 or 255.
+    magnitude : ndarray float32
+        Foreground magnitude at the processing size.
+    frame_id : int
+        Sequence number of the frame since the last reset.
+    buffered : bool
+        False if the frame was not kept in a window (motionless, or a
+        detector without a window).
+    reset : bool
+        True if the detector restarted at this frame (size change).
+    model_ready : bool
+        False while warming up (no background model yet).
+    new_background : bool
+        True when :meth:`StreamingDetector.background_image` has a background
+        not announced before: the one rule for publishing backgrounds.
+    solve_error : str or None
+        Set by :meth:`StreamingDetector.process` when a due solve failed.
+
+    """
+
+    mask: np.ndarray
+    magnitude: np.ndarray
+    frame_id: int
+    buffered: bool
+    reset: bool
+    model_ready: bool
+    new_background: bool = False
+    solve_error: str = None
+
+
+@dataclass(frozen=True)
+class SolveTicket:
+    """
+    Which detector, in which configuration, started a solve.
+
+    ``owner`` is an opaque token unique to one detector object; ``generation``
+    counts that detector's reconfigurations and restarts. A solved model is
+    installed only by the detector and generation on its ticket.
+    """
+
+    owner: object
+    generation: int
+
+
+@dataclass
+class WindowSnapshot:
+    """
+    A copy of the buffered window and everything its solve needs.
+
+    Solving reads nothing else, so it is safe in another thread while frames
+    are pushed and parameters change.
+    """
+
+    data: np.ndarray            # (C, n, m) float32
+    shape: tuple                # (rows, cols, C)
+    first_id: int
+    last_id: int
+    previous: object            # BackgroundModel or None, for the warm start
+    model: object               # the estimator configured when the snapshot was taken
+    mask_rule: object           # likewise the MaskRule
+    basis_rank: int             # likewise the fast path's basis size
+    ticket: SolveTicket = None
+
+
+@dataclass
+class BackgroundModel:
+    """
+    What a window solve leaves for the fast path.
+
+    Attributes
+    ----------
+    basis : ndarray (C, n, r)
+        Orthonormal basis of each channel's background columns.
+    background : ndarray (rows, cols, C)
+        The newest background column as an image at the processing size.
+    mean_background : ndarray (rows, cols, C)
+        The window's mean background (the paper's background estimate).
+    threshold : float
+        Mask threshold estimated from this window's residual.
+    shape : tuple
+        (rows, cols, C) processing shape the model belongs to.
+    first_id, last_id : int
+        Sequence numbers of the window's oldest and newest frame.
+    states : list
+        Per-channel solver states for a warm start (None if the method has none).
+    seconds, iterations, info : float, int, int
+        Cost and outcome of the solve.
+    ticket : SolveTicket or None
+        The snapshot's ticket: who may install this model.
+
+    """
+
+    basis: np.ndarray
+    background: np.ndarray
+    mean_background: np.ndarray
+    threshold: float
+    shape: tuple
+    first_id: int
+    last_id: int
+    states: list = field(default_factory=list)
+    seconds: float = 0.0
+    iterations: int = 0
+    info: int = 0
+    ticket: SolveTicket = None
