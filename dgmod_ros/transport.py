@@ -59,7 +59,7 @@ class LargeImageCheck:
             if self.warned_:
                 return None
             self.warned_ = True
-        return (f'images of {size_bytes} bytes exceed the default Fast DDS {DEFAULT_SEGMENT_BYTES} '
-                f'byte shared-memory segment and {PROFILE_VARIABLE} is not set: frames from '
+        return (f'images of {size_bytes} bytes exceed the default Fast DDS '
+                f'{DEFAULT_SEGMENT_BYTES} byte shared-memory segment and {PROFILE_VARIABLE} is not set: frames from '
                 f'another process will be lost. Set {PROFILE_VARIABLE}={profile_path()} for the '
                 f'camera driver and this node (docs/node.md, "Transport").')
