@@ -60,6 +60,7 @@ class LargeImageCheck:
                 return None
             self.warned_ = True
         return (f'images of {size_bytes} bytes exceed the default Fast DDS '
-                f'{DEFAULT_SEGMENT_BYTES} byte shared-memory segment and {PROFILE_VARIABLE} '
-                f'is not set: frames from another process will be lost. Set {PROFILE_VARIABLE}={profile_path()} for the '
-                f'camera driver and this node (docs/node.md, "Transport").')
+                f'{DEFAULT_SEGMENT_BYTES} byte shared-memory segment and '
+                f'{PROFILE_VARIABLE} is not set: frames from another process will be '
+                f'lost. Set {PROFILE_VARIABLE}={profile_path()} for the camera driver '
+                f'and this node (docs/node.md, "Transport").')
