@@ -92,10 +92,12 @@ def _shrink(x, t):
 
 # Reassociation lets the compiler vectorise the sums of squares; no
 # 'nnan'/'ninf': the solver detects a non-finite iterate from those sums.
+# nogil: a pass takes milliseconds, and the node's image callback must not
+# wait for the solve thread's kernels.
 _FAST = {'reassoc', 'contract', 'nsz'}
 
 
-@njit(parallel=True, cache=True, fastmath=_FAST)
+@njit(parallel=True, cache=True, fastmath=_FAST, nogil=True)
 def primal_pass(data, L, U, Y1, S, V, Y2,
                 s_offsets, s_bands, t_offsets, t_bands, coefficients, l_given,
                 L_new, S_new, V_new, Lh):
@@ -179,7 +181,7 @@ def primal_pass(data, L, U, Y1, S, V, Y2,
     return sums.sum(axis=0)
 
 
-@njit(parallel=True, cache=True, fastmath=_FAST)
+@njit(parallel=True, cache=True, fastmath=_FAST, nogil=True)
 def dual_pass(data, L, S, V, U, Y1, Y2):
     """
     Update the duals ``Y1 += U - L``, ``Y2 += D - L - S - V`` in one threaded pass.
@@ -203,3 +205,17 @@ def dual_pass(data, L, S, V, U, Y1, Y2):
         sums[b, 0] = r_u
         sums[b, 1] = r_v
     return sums.sum(axis=0)
+
+
+def compile_all():
+    """
+    Compile (or load from the cache) every kernel by running it on a tiny window.
+
+    A cold compile takes tens of seconds on a small machine and holds the GIL;
+    run this once after installing (``python3 -c 'from dgmod_ros.core.kernels
+    import compile_all; compile_all()'``) so the node starts from the cache.
+    """
+    from .dgmod import DualGraphMOD
+    data = np.linspace(0.0, 1.0, 12 * 4, dtype=np.float32).reshape(12, 4)
+    DualGraphMOD(max_iter=1).fit(data, (3, 4))
+    DualGraphMOD(max_iter=1, l_step='exact').fit(data, (3, 4))
