@@ -386,8 +386,8 @@ class DualGraphMOD:
         """
         from . import kernels       # numba compiles or loads its cache on first use
 
-        def contiguous(array):
-            return np.require(array, np.float32, 'C').copy()
+        def contiguous(array):      # fit's copies already are; no second copy
+            return np.require(array, np.float32, ['C', 'W'])
 
         L, S, U, V, Y1, Y2 = (contiguous(iterates[k]) for k in ('L', 'S', 'U', 'V', 'Y1', 'Y2'))
         weights, sigma = iterates['weights'], iterates['sigma']
