@@ -20,7 +20,7 @@ to first mask). The issue asks
 for 60 s runs; ``--seconds`` defaults to 20 for a quick look.
 
 Usage (repo root): PYTHONPATH=. python benchmarks/bench_node.py [--seconds 60]
-    [--sizes 320x240,640x480] [--no-profile]
+    [--sizes 320x240,640x480] [--receivers null,defaults,full] [--no-profile]
 """
 
 import argparse
@@ -33,9 +33,9 @@ import time
 
 REPO = Path(__file__).resolve().parents[1]
 PROFILE = REPO / 'config' / 'fastdds_large_images.xml'
-RECEIVERS = (('do-nothing node', 'null', []),
-             ('detector, defaults', 'detector', []),
-             ('detector, scale:=1.0', 'detector', ['scale:=1.0']))
+RECEIVERS = {'null': ('do-nothing node', 'null', []),
+             'defaults': ('detector, defaults', 'detector', []),
+             'full': ('detector, scale:=1.0', 'detector', ['scale:=1.0'])}
 
 
 def resident_mb():
@@ -230,6 +230,8 @@ def main(argv=None):
                         help='measured seconds per receiver (the issue asks 60)')
     parser.add_argument('--rate', type=float, default=30.0)
     parser.add_argument('--sizes', default='320x240,640x480')
+    parser.add_argument('--receivers', default='null,defaults,full',
+                        help='which of null, defaults, full (scale:=1.0) to run')
     parser.add_argument('--no-profile', action='store_true',
                         help='leave FASTRTPS_DEFAULT_PROFILES_FILE as it is')
     parser.add_argument('--startup-allowance', type=float, default=10.0,
@@ -254,7 +256,8 @@ def main(argv=None):
           flush=True)
     for size in args.sizes.split(','):
         print(f'{size}:', flush=True)
-        for name, receiver, params in RECEIVERS:
+        for key in args.receivers.split(','):
+            name, receiver, params = RECEIVERS[key]
             camera, figures = measure(size, receiver, params, args, environ)
             report(name, camera, figures, args.rate)
 
