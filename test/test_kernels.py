@@ -64,6 +64,7 @@ def test_fused_solve_stops_where_numpy_stops_and_warm_starts_alike():
     assert_same_iterates(second[0], second[1], atol=1e-4)
 
 
+@pytest.mark.filterwarnings('ignore:overflow encountered', 'ignore:invalid value encountered')
 def test_non_finite_iterate_stops_both_engines_alike():
     # A gradient step far beyond 1 / Lipschitz diverges to inf within a few sweeps.
     data = scene_window()
