@@ -2,10 +2,12 @@
 # Licensed under the Apache License, Version 2.0
 """The fused numba sweep against the literal numpy sweep, and kernels from two threads."""
 
+import ctypes
 import threading
 
 from dgmod_ros.core import kernels
 from dgmod_ros.core.dgmod import DualGraphMOD
+from dgmod_ros.core.runtime import limit_blas_threads
 from dgmod_ros.core.synthetic import synthetic_scene
 import numba
 import numpy as np
@@ -122,3 +124,21 @@ def test_cache_folder_defaults_to_the_user_cache(monkeypatch, tmp_path):
     assert kernels.default_cache_dir() == str(tmp_path / 'dgmod_ros' / 'numba')
     assert numba.config.CACHE_DIR       # set before the first compiled call
     assert numba.config.THREADING_LAYER == 'threadsafe'
+
+
+def test_openblas_runs_on_one_thread_after_a_fused_solve():
+    import scipy.linalg  # noqa: F401 (scipy's own OpenBLAS, loaded after the kernels)
+    DualGraphMOD(max_iter=1).fit(scene_window(), SHAPE)
+    getters = ('openblas_get_num_threads', 'openblas_get_num_threads64_',
+               'scipy_openblas_get_num_threads', 'scipy_openblas_get_num_threads64_')
+    with open('/proc/self/maps') as maps:
+        paths = {line.split()[-1] for line in maps
+                 if 'openblas' in line.lower() and '.so' in line}
+    counts = []
+    for path in paths:
+        library = ctypes.CDLL(path)
+        counts += [getattr(library, name)() for name in getters if hasattr(library, name)][:1]
+    if not counts:
+        pytest.skip('no OpenBLAS loaded (another BLAS: nothing to limit)')
+    assert set(counts) == {1}
+    assert limit_blas_threads(1) == len(counts)

@@ -8,6 +8,7 @@ import numpy as np
 
 from .graphs import spatial_laplacian, temporal_laplacian
 from .linalg import drop_oldest, mixing_factors, relative_change, shrink, singular_value_map
+from .runtime import limit_blas_threads
 
 
 @dataclass
@@ -385,6 +386,9 @@ class DualGraphMOD:
         the rank-k product ``U = (Lh left) right_t``.
         """
         from . import kernels       # numba compiles or loads its cache on first use
+        # Again at every solve: an OpenBLAS loaded since (scipy.linalg's) must
+        # not spin beside the kernels either (kernels module docstring).
+        limit_blas_threads(1)
 
         def contiguous(array):      # fit's copies already are; no second copy
             return np.require(array, np.float32, ['C', 'W'])

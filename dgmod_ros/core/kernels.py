@@ -17,8 +17,7 @@ Between them the weighted SVT stays with BLAS: the Gram matrix ``Lh^T Lh``
 and the rank-k product ``U = (Lh left) right_t`` are dense products that a
 hand-written loop does several times slower than sgemm.
 
-Import side effects, both process-wide and both needed before the first
-compiled call:
+Import side effects, all process-wide and made before the first compiled call:
 
 - ``NUMBA_CACHE_DIR`` defaults to ``$XDG_CACHE_HOME/dgmod_ros/numba`` (else
   ``~/.cache/dgmod_ros/numba``) when unset, so an installed package in a
@@ -27,7 +26,10 @@ compiled call:
 - ``numba.config.THREADING_LAYER = 'threadsafe'``: the node calls kernels from
   its image callback and its solve thread at once, and numba's ``workqueue``
   fallback stops the process when two threads enter it. ``threadsafe`` makes
-  numba take ``tbb`` or ``omp`` (libgomp, which comes with gcc) or fail loudly.
+  numba take ``tbb`` or ``omp`` (libgomp, which comes with gcc) or fail loudly;
+- OpenBLAS runs on one thread (:func:`~dgmod_ros.core.runtime.limit_blas_threads`):
+  the kernels own the cores, and OpenBLAS threads spinning beside them made a
+  sweep several times slower (docs/solver.md, "Fused sweep").
 """
 
 import os
@@ -46,6 +48,7 @@ if not os.environ.get('NUMBA_CACHE_DIR'):
 import numba  # noqa: E402 (the cache folder must be set before numba reads its config)
 from numba import njit, prange  # noqa: E402
 import numpy as np  # noqa: E402
+import scipy.sparse as sp  # noqa: E402
 
 from .runtime import limit_blas_threads  # noqa: E402
 
@@ -69,19 +72,14 @@ def diagonal_bands(matrix):
     offsets 0, +-1, +-n2; frames: the temporal reach), so a product with them
     is a few shifted multiply-adds per row that the compiler vectorises.
     """
-    coo = (matrix.tocoo() if hasattr(matrix, 'tocoo')
-           else _dense_to_coo(np.asarray(matrix)))
+    coo = sp.coo_matrix(matrix)
+    coo.sum_duplicates()
     n = coo.shape[0]
     diff = coo.col.astype(np.int64) - coo.row.astype(np.int64)
     offsets = np.unique(diff)
     bands = np.zeros((offsets.size, n), dtype=np.float32)
     bands[np.searchsorted(offsets, diff), coo.row] = coo.data
     return offsets.astype(np.int64), bands
-
-
-def _dense_to_coo(dense):
-    import scipy.sparse as sp
-    return sp.coo_matrix(dense)
 
 
 @njit(cache=True, inline='always')
