@@ -14,9 +14,10 @@ setup(
     data_files=[
         ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
         ('share/' + package_name, ['package.xml']),
-        (os.path.join('share', package_name, 'config'), glob('config/*.yaml')),
+        (os.path.join('share', package_name, 'config'),
+         glob('config/*.yaml') + glob('config/*.xml')),
     ],
-    install_requires=['setuptools'],
+    install_requires=['setuptools', 'numba'],
     zip_safe=True,
     maintainer='dgmod_ros maintainers',
     maintainer_email='maintainers@dgmod-ros.invalid',

@@ -32,6 +32,7 @@ from .core.streaming import SolverFailure
 from .image_conversion import fill_image, image_to_array, ImageConversionError
 from .solve_worker import SolveWorker
 from .stats import DetectorStats
+from .transport import LargeImageCheck
 
 # Seconds between repeats of one kind of warning.
 _WARN_PERIOD = 5.0
@@ -65,6 +66,7 @@ class DetectorNode(Node):
         self._detector = config.build_detector(self._values)
         self._lock = threading.Lock()       # guards the detector between callbacks
         self._stats = DetectorStats()
+        self._large_images = LargeImageCheck()
         self._encoding = None
         self._worker = SolveWorker(self._solve, self._on_solved, self._on_solve_error)
 
@@ -93,7 +95,11 @@ class DetectorNode(Node):
     # ----------------------------------------------------------------- frames
     def _on_image(self, msg):
         received = time.monotonic()
-        self._stats.received()
+        stamp = msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec
+        self._stats.received(stamp or None)     # an unset (zero) stamp says nothing
+        advice = self._large_images.check(len(msg.data))
+        if advice:
+            self.get_logger().warning(advice)
         try:
             image, order = image_to_array(msg, self._values['max_pixels'])
         except ImageConversionError as error:

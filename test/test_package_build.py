@@ -44,6 +44,7 @@ def test_installed_layout(install):
         assert path.is_file() and os.access(path, os.X_OK)
     share = install / 'share'
     assert (share / 'dgmod_ros' / 'config' / 'detector.yaml').is_file()
+    assert (share / 'dgmod_ros' / 'config' / 'fastdds_large_images.xml').is_file()
     assert (share / 'dgmod_ros' / 'package.xml').is_file()
     assert (share / 'ament_index' / 'resource_index' / 'packages' / 'dgmod_ros').is_file()
 
