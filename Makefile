@@ -4,7 +4,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.requirements-installed
 
-.PHONY: demo test bench bench-node bench-soak bench-depth clean
+.PHONY: demo test bench bench-node bench-stream bench-soak bench-depth clean
 
 $(STAMP): requirements.txt setup.py
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -25,7 +25,10 @@ bench: $(STAMP)
 	PYTHONPATH=. $(PY) benchmarks/bench_solver.py
 
 bench-node: $(STAMP)
-	PYTHONPATH=. $(PY) benchmarks/bench_node.py
+	PYTHONPATH=. $(PY) benchmarks/bench_node.py $(BENCH_ARGS)
+
+bench-stream: $(STAMP)
+	PYTHONPATH=. $(PY) benchmarks/bench_stream.py $(BENCH_ARGS)
 
 bench-soak: $(STAMP)
 	PYTHONPATH=. $(PY) benchmarks/bench_soak.py

@@ -14,7 +14,8 @@ setup(
     data_files=[
         ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
         ('share/' + package_name, ['package.xml']),
-        (os.path.join('share', package_name, 'config'), glob('config/*.yaml')),
+        (os.path.join('share', package_name, 'config'),
+         glob('config/*.yaml') + glob('config/*.xml')),
         (os.path.join('share', package_name, 'launch'), glob('launch/*.launch.xml')),
     ],
     # What the code imports at run time, besides ROS 2 (rclpy and the message
@@ -22,7 +23,7 @@ setup(
     # requirements.txt pins; they are declared in package.xml). rosbags is for
     # the offline command's rosbag2 input.
     install_requires=['setuptools', 'numpy', 'scipy', 'opencv-python-headless', 'PyYAML',
-                      'rosbags'],
+                      'numba', 'rosbags'],
     zip_safe=True,
     maintainer='dgmod_ros maintainers',
     maintainer_email='maintainers@dgmod-ros.invalid',

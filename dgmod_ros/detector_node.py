@@ -46,6 +46,7 @@ from .image_conversion import (compressed_image_to_array, fill_image, image_to_a
                                ImageConversionError)
 from .solve_worker import SolveWorker
 from .stats import DetectorStats
+from .transport import LargeImageCheck
 
 # Seconds between repeats of one kind of warning.
 _WARN_PERIOD = 5.0
@@ -86,6 +87,7 @@ class DetectorNode(LifecycleNode):
         self._worker = None
         self._active = False
         self._lifecycle_state = 'unconfigured'
+        self._large_images = LargeImageCheck()
         self._encoding = None
         self._frames_ignored = 0
         self._foreground_share = None
@@ -212,7 +214,11 @@ class DetectorNode(LifecycleNode):
             self._frames_ignored += 1   # inactive: counted apart, never masked
             return
         received = time.monotonic()
-        self._stats.received()
+        stamp = msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec
+        self._stats.received(stamp or None)     # an unset (zero) stamp says nothing
+        advice = self._large_images.check(len(msg.data))
+        if advice:
+            self.get_logger().warning(advice)
         try:
             image, order = convert(msg, self._values['max_pixels'])
         except ImageConversionError as error:

@@ -45,6 +45,7 @@ def test_installed_layout(install):
     share = install / 'share'
     assert (share / 'dgmod_ros' / 'config' / 'detector.yaml').is_file()
     assert (share / 'dgmod_ros' / 'launch' / 'detector.launch.xml').is_file()
+    assert (share / 'dgmod_ros' / 'config' / 'fastdds_large_images.xml').is_file()
     assert (share / 'dgmod_ros' / 'package.xml').is_file()
     assert (share / 'ament_index' / 'resource_index' / 'packages' / 'dgmod_ros').is_file()
 

@@ -3,6 +3,7 @@
 """The node's counters and its frozen-background rule, on a clock the test drives."""
 
 from dgmod_ros.stats import DetectorStats
+import numpy as np
 import pytest
 
 
@@ -69,3 +70,51 @@ def test_counters_add_up():
     assert (figures['frames_in'], figures['masks_out'], figures['frames_dropped']) == (5, 2, 1)
     assert figures['dropped_encoding'] == 1
     assert figures['mask_latency_p50_ms'] == pytest.approx(3.0)
+
+
+def feed(stats, clock, stamps, period=1 / 30):
+    """Receive one frame per ``period`` of the clock with the given header stamps."""
+    for stamp in stamps:
+        stats.received(stamp)
+        clock.now += period
+
+
+def test_received_rate_follows_the_arrivals(clock):
+    stats = DetectorStats(clock=clock, rate_window=31)
+    assert np.isnan(stats.snapshot()['received_rate_hz'])
+    feed(stats, clock, [None] * 100, period=0.04)
+    assert stats.snapshot()['received_rate_hz'] == pytest.approx(25.0)
+    feed(stats, clock, [None] * 40, period=0.1)           # the window forgets the old rate
+    assert stats.snapshot()['received_rate_hz'] == pytest.approx(10.0)
+
+
+def test_gaps_in_the_stamps_are_counted_with_the_largest(clock):
+    stats = DetectorStats(clock=clock)
+    stamps = list(1000.0 + np.arange(60) / 30)             # 30 frames/s, no gap
+    stamps += list(stamps[-1] + 3 / 30 + np.arange(30) / 30)    # two frames lost
+    stamps += list(stamps[-1] + 11 / 30 + np.arange(30) / 30)   # ten frames lost
+    feed(stats, clock, stamps)
+    figures = stats.snapshot()
+    assert figures['stamp_gaps'] == 2
+    assert figures['stamp_gap_largest_ms'] == pytest.approx(1e3 * 11 / 30)
+    assert figures['stamp_period_median_ms'] == pytest.approx(1e3 / 30)
+    assert figures['frames_in'] == 120
+
+
+def test_jitter_below_the_factor_and_repeated_stamps_are_no_gaps(clock):
+    stats = DetectorStats(clock=clock)
+    rng = np.random.default_rng(0)
+    periods = (1 + rng.uniform(-0.3, 0.3, 200)) / 30       # +-30% jitter < 1.5x
+    stamps = list(50.0 + np.cumsum(periods))
+    stamps.insert(100, stamps[99])                         # a repeated stamp
+    stamps.insert(150, stamps[140])                        # one going back
+    feed(stats, clock, stamps)
+    figures = stats.snapshot()
+    assert figures['stamp_gaps'] == 0 and figures['stamp_gap_largest_ms'] == 0.0
+    assert figures['stamps_not_increasing'] == 2
+
+
+def test_the_first_intervals_decide_nothing(clock):
+    stats = DetectorStats(clock=clock)
+    feed(stats, clock, [0.0, 1.0, 1.1, 1.2])               # no median yet: no gap
+    assert stats.snapshot()['stamp_gaps'] == 0

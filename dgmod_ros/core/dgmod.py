@@ -7,8 +7,9 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .graphs import spatial_laplacian, temporal_laplacian
-from .linalg import (drop_oldest, relative_change, shrink, singular_value_map,
-                     top_singular_value)
+from .linalg import (drop_oldest, mixing_factors, relative_change, shrink,
+                     singular_value_map, top_singular_value)
+from .runtime import limit_blas_threads
 from .window_data import check_window_data
 
 
@@ -119,6 +120,12 @@ class DualGraphMOD:
     svd : {'gram', 'full'}, default='gram'
         'gram' takes the thin SVD through the m x m Gram matrix; 'full' calls
         LAPACK on the tall matrix (the literal reference).
+    engine : {'fused', 'numpy'}, default='fused'
+        'fused' runs a sweep as two compiled, multi-threaded passes
+        (:mod:`dgmod_ros.core.kernels`); 'numpy' is the literal formulation,
+        one numpy expression per step, which the tests compare it with. Both
+        give the same iterates to float32 rounding. ``svd='full'`` (the literal
+        reference) always runs the numpy formulation.
     tol : float, default=1e-4
         Stop when the relative changes of L and S and the relative primal
         residuals ``||U - L|| / ||D||``, ``||D - L - S - V|| / ||D||`` are all
@@ -161,7 +168,7 @@ class DualGraphMOD:
     def __init__(self, lambda1=None, lambda2=0.5, gamma1=0.5, gamma2=0.5, rho1=20.0, rho2=20.0,
                  weight_scale=None, h_s=None, h_t=None, patch_size=3, smoothing_sigma=0.0,
                  temporal_neighbors=4, l_step='gradient', inner_iter=1, step_size=None,
-                 svd='gram', tol=1e-4, max_iter=300):
+                 svd='gram', engine='fused', tol=1e-4, max_iter=300):
         self.lambda1 = lambda1
         self.lambda2 = lambda2
         self.gamma1 = gamma1
@@ -178,6 +185,7 @@ class DualGraphMOD:
         self.inner_iter = inner_iter
         self.step_size = step_size
         self.svd = svd
+        self.engine = engine
         self.tol = tol
         self.max_iter = max_iter
 
@@ -204,6 +212,8 @@ class DualGraphMOD:
             raise ValueError(f"l_step must be 'exact' or 'gradient', got {self.l_step!r}")
         if self.svd not in ('gram', 'full'):
             raise ValueError(f"svd must be 'gram' or 'full', got {self.svd!r}")
+        if self.engine not in ('fused', 'numpy'):
+            raise ValueError(f"engine must be 'fused' or 'numpy', got {self.engine!r}")
         if int(self.patch_size) != self.patch_size or self.patch_size < 1 \
                 or self.patch_size % 2 == 0:
             raise ValueError(f'patch_size must be a positive odd integer, got {self.patch_size!r}')
@@ -292,6 +302,142 @@ class DualGraphMOD:
             rr = rr_new
         return z @ basis.T
 
+    def _record(self, history, change_L, change_S, residual_U, residual_V, rank):
+        """Append one sweep's figures to ``history``; return True when the stopping rule holds."""
+        for key, value in (('change_L', change_L), ('change_S', change_S),
+                           ('residual_U', residual_U), ('residual_V', residual_V),
+                           ('rank', rank)):
+            history[key].append(value)
+        return max(change_L, change_S, residual_U, residual_V) < self.tol
+
+    def _run_numpy(self, data, ops, iterates, history, data_norm):
+        """Sweep with one numpy expression per step (the literal formulation)."""
+        L, S, U, V = iterates['L'], iterates['S'], iterates['U'], iterates['V']
+        Y1, Y2, weights, sigma = (iterates['Y1'], iterates['Y2'], iterates['weights'],
+                                  iterates['sigma'])
+        rho1, rho2 = float(self.rho1), float(self.rho2)
+        # Scratch buffers: a sweep is ~25 passes over n x m arrays, and
+        # allocating each temporary would cost as much as the arithmetic.
+        rhs = np.empty_like(data)
+        work = np.empty_like(data)
+        residual = np.empty_like(data)
+        S_new = np.empty_like(data)
+        V_new = np.empty_like(data)
+        for _ in range(self.max_iter):
+            # 1. L-step, right-hand side rho1 (U + Y1) + rho2 (D - S - V + Y2).
+            self._l_rhs(data, U, Y1, S, V, Y2, rhs, work)
+            L_new = self._l_step(rhs, L, ops, rho1 + rho2)
+            # 2. S-step.
+            np.subtract(data, L_new, out=residual)                    # D - L
+            np.subtract(residual, V, out=work)
+            work += Y2
+            shrink(work, self.lambda2 / rho2, out=S_new)
+            # 3. U-step (weights from the previous sweep), then new weights.
+            np.subtract(L_new, Y1, out=work)
+            U_new, sigma, rank = self._weighted_svt(work, weights, self.lambda1_ / rho1)
+            # 4. V-step.
+            np.subtract(residual, S_new, out=work)
+            work += Y2
+            shrink(work, 1.0 / rho2, out=V_new)
+            if not (np.isfinite(sigma).all() and np.isfinite(U_new).all()
+                    and np.isfinite(S_new).all()):
+                self.info_ = -1
+                break
+            weights = np.exp(-(sigma / self.weight_scale_) ** 2).astype(np.float32)
+            change_L = relative_change(L_new, L)
+            change_S = relative_change(S_new, S)
+            S, S_new = S_new, S
+            V, V_new = V_new, V
+            L, U = L_new, U_new
+            # 5. Dual updates with the primal residuals.
+            np.subtract(U, L, out=work)
+            residual_U = float(np.linalg.norm(work)) / data_norm
+            Y1 += work
+            residual -= S
+            residual -= V                                             # D - L - S - V
+            residual_V = float(np.linalg.norm(residual)) / data_norm
+            Y2 += residual
+            # 6. Stop.
+            if self._record(history, change_L, change_S, residual_U, residual_V, rank):
+                self.info_ = 0
+                break
+        iterates.update(L=L, S=S, U=U, V=V, Y1=Y1, Y2=Y2, weights=weights, sigma=sigma)
+
+    def _l_rhs(self, data, U, Y1, S, V, Y2, rhs, work):
+        """Write the L-step's right-hand side ``rho1 (U + Y1) + rho2 (D - S - V + Y2)``."""
+        np.add(U, Y1, out=rhs)
+        rhs *= self.rho1
+        np.subtract(data, S, out=work)
+        work -= V
+        work += Y2
+        work *= self.rho2
+        rhs += work
+        return rhs
+
+    def _run_fused(self, data, ops, iterates, history, data_norm):
+        """
+        Sweep with the two compiled passes of :mod:`dgmod_ros.core.kernels`.
+
+        The same steps as :meth:`_run_numpy` in the same order; between the
+        passes BLAS forms the Gram matrix of ``Lh = L - Y1`` and the SVT as
+        the rank-k product ``U = (Lh left) right_t``.
+        """
+        from . import kernels       # numba compiles or loads its cache on first use
+        # Again at every solve: an OpenBLAS loaded since (scipy.linalg's) must
+        # not spin beside the kernels either (kernels module docstring).
+        limit_blas_threads(1)
+
+        def contiguous(array):      # fit's copies already are; no second copy
+            return np.require(array, np.float32, ['C', 'W'])
+
+        L, S, U, V, Y1, Y2 = (contiguous(iterates[k]) for k in ('L', 'S', 'U', 'V', 'Y1', 'Y2'))
+        weights, sigma = iterates['weights'], iterates['sigma']
+        rho1, rho2 = float(self.rho1), float(self.rho2)
+        g1, g2, c = float(self.gamma1), float(self.gamma2), rho1 + rho2
+        step = self.step_size or 1.0 / (2.0 * g1 + 2.0 * g2 + c)
+        coefficients = np.array([g1, g2, c, rho1, rho2, step, self.lambda2 / rho2, 1.0 / rho2])
+        s_offsets, s_bands = kernels.diagonal_bands(ops['phi_s'])
+        # The kernel reads Phi_t[j, j + off]; Phi_t is symmetric, so its own bands serve.
+        t_offsets, t_bands = kernels.diagonal_bands(ops['phi_t'])
+        # Other L-steps than one gradient step run in numpy and hand L_new over.
+        l_given = not (self.l_step == 'gradient' and self.inner_iter == 1)
+        L_new, S_new, V_new, Lh = (np.empty_like(data) for _ in range(4))
+        rhs = work = None
+        threshold = self.lambda1_ / rho1
+        for _ in range(self.max_iter):
+            if l_given:
+                if rhs is None:
+                    rhs, work = np.empty_like(data), np.empty_like(data)
+                self._l_rhs(data, U, Y1, S, V, Y2, rhs, work)
+                np.copyto(L_new, self._l_step(rhs, L, ops, c))
+            sums = kernels.primal_pass(
+                data, L, U, Y1, S, V, Y2, s_offsets, s_bands, t_offsets, t_bands,
+                coefficients, l_given, L_new, S_new, V_new, Lh)
+            gram = Lh.T @ Lh
+            if not (np.isfinite(gram).all() and np.isfinite(sums).all()):
+                self.info_ = -1     # L_new, S_new, V_new are dropped; Y1, Y2 untouched
+                break
+            if threshold == 0:      # no nuclear norm (FRPCAG): the prox is the identity
+                left = right_t = np.eye(data.shape[1], dtype=np.float32)
+                sigma, rank = np.zeros(data.shape[1]), data.shape[1]
+            else:
+                left, right_t, sigma, rank = mixing_factors(gram, lambda values: np.maximum(
+                    values - weights[:values.size] * threshold, 0.0))
+            weights = np.exp(-(sigma / self.weight_scale_) ** 2).astype(np.float32)
+            change_L = _ratio(sums[0], sums[1])
+            change_S = _ratio(sums[2], sums[3])
+            L, L_new = L_new, L
+            S, S_new = S_new, S
+            V, V_new = V_new, V
+            np.matmul(Lh @ left.astype(np.float32), right_t.astype(np.float32), out=U)
+            residual_U, residual_V = np.sqrt(
+                kernels.dual_pass(data, L, S, V, U, Y1, Y2)) / data_norm
+            if self._record(history, change_L, change_S, float(residual_U),
+                            float(residual_V), rank):
+                self.info_ = 0
+                break
+        iterates.update(L=L, S=S, U=U, V=V, Y1=Y1, Y2=Y2, weights=weights, sigma=sigma)
+
     # ------------------------------------------------------------------ public
     def build_operators(self, data, frame_shape):
         """Graph Laplacians and the temporal eigenbasis for one window."""
@@ -343,66 +489,17 @@ class DualGraphMOD:
         S = data - L - state.noise if init is not None else state.foreground.copy()
         U, V = state.low_rank.copy(), state.noise.copy()
         Y1, Y2 = state.dual_low_rank.copy(), state.dual_noise.copy()
-        weights = state.weights
-        rho1, rho2 = float(self.rho1), float(self.rho2)
+        iterates = {'L': L, 'S': S, 'U': U, 'V': V, 'Y1': Y1, 'Y2': Y2,
+                    'weights': state.weights, 'sigma': np.zeros(m)}
         history = {k: [] for k in ('change_L', 'change_S', 'residual_U', 'residual_V', 'rank')}
         self.info_ = self.max_iter
-        sigma = np.zeros(m)
-        # Scratch buffers: a sweep is ~25 passes over n x m arrays, and
-        # allocating each temporary would cost as much as the arithmetic.
-        rhs = np.empty_like(data)
-        work = np.empty_like(data)
-        residual = np.empty_like(data)
-        S_new = np.empty_like(data)
-        V_new = np.empty_like(data)
-        for _ in range(self.max_iter):
-            # 1. L-step, right-hand side rho1 (U + Y1) + rho2 (D - S - V + Y2).
-            np.add(U, Y1, out=rhs)
-            rhs *= rho1
-            np.subtract(data, S, out=work)
-            work -= V
-            work += Y2
-            work *= rho2
-            rhs += work
-            L_new = self._l_step(rhs, L, ops, rho1 + rho2)
-            # 2. S-step.
-            np.subtract(data, L_new, out=residual)                    # D - L
-            np.subtract(residual, V, out=work)
-            work += Y2
-            shrink(work, self.lambda2 / rho2, out=S_new)
-            # 3. U-step (weights from the previous sweep), then new weights.
-            np.subtract(L_new, Y1, out=work)
-            U_new, sigma, rank = self._weighted_svt(work, weights, self.lambda1_ / rho1)
-            # 4. V-step.
-            np.subtract(residual, S_new, out=work)
-            work += Y2
-            shrink(work, 1.0 / rho2, out=V_new)
-            if not (np.isfinite(sigma).all() and np.isfinite(U_new).all()
-                    and np.isfinite(S_new).all()):
-                self.info_ = -1
-                break
-            weights = np.exp(-(sigma / self.weight_scale_) ** 2).astype(np.float32)
-            change_L = relative_change(L_new, L)
-            change_S = relative_change(S_new, S)
-            S, S_new = S_new, S
-            V, V_new = V_new, V
-            L, U = L_new, U_new
-            # 5. Dual updates with the primal residuals.
-            np.subtract(U, L, out=work)
-            residual_U = float(np.linalg.norm(work)) / data_norm
-            Y1 += work
-            residual -= S
-            residual -= V                                             # D - L - S - V
-            residual_V = float(np.linalg.norm(residual)) / data_norm
-            Y2 += residual
-            for key, value in (('change_L', change_L), ('change_S', change_S),
-                               ('residual_U', residual_U), ('residual_V', residual_V),
-                               ('rank', rank)):
-                history[key].append(value)
-            # 6. Stop.
-            if max(change_L, change_S, residual_U, residual_V) < self.tol:
-                self.info_ = 0
-                break
+        if self.engine == 'fused' and self.svd == 'gram':
+            self._run_fused(data, ops, iterates, history, data_norm)
+        else:
+            self._run_numpy(data, ops, iterates, history, data_norm)
+        L, S, U, V = iterates['L'], iterates['S'], iterates['U'], iterates['V']
+        Y1, Y2, weights, sigma = (iterates['Y1'], iterates['Y2'], iterates['weights'],
+                                  iterates['sigma'])
         self.n_iter_ = len(history['change_L'])
         self.history_ = history
         self.singular_values_ = sigma
@@ -411,3 +508,10 @@ class DualGraphMOD:
         self.background_ = L
         self.foreground_ = S
         return self
+
+
+def _ratio(squared_change, squared_norm):
+    """``sqrt(a / b)`` as :func:`relative_change` from sums of squares (0 / 0 is 0)."""
+    if squared_norm == 0.0:
+        return 0.0 if squared_change == 0.0 else np.inf
+    return float(np.sqrt(squared_change / squared_norm))

@@ -40,6 +40,28 @@ def top_singular_value(matrix):
     return float(gram_eigh(matrix, vectors=False)[0])
 
 
+def mixing_factors(gram, transform):
+    """
+    Factor the mixing matrix of :func:`singular_value_map` from the Gram matrix ``A^T A``.
+
+    Returns ``(left, right_t, sigma, rank)`` with ``left = B_k diag(transform(sigma) / sigma)``
+    (m x k) and ``right_t = B_k^T`` (k x m) over the k singular values that the
+    transform keeps positive, so that ``A left right_t`` is the mapped matrix.
+    A non-finite Gram matrix gives NaN singular values and rank 0 (callers
+    check ``sigma`` to detect a diverged iterate).
+    """
+    gram = np.asarray(gram, dtype=np.float64)
+    m = gram.shape[0]
+    if not np.isfinite(gram).all():     # a diverged iterate: NaN singular values, no factors
+        return np.zeros((m, 0)), np.zeros((0, m)), np.full(m, np.nan), 0
+    eigval, eigvec = np.linalg.eigh(gram)
+    sigma, right = np.sqrt(np.clip(eigval[::-1], 0.0, None)), eigvec[:, ::-1]
+    new = np.asarray(transform(sigma), dtype=np.float64)
+    keep = (new > 0) & (sigma > 1e-12 * max(sigma[0], 1e-300))
+    return (right[:, keep] * (new[keep] / sigma[keep]), right[:, keep].T, sigma,
+            int(np.count_nonzero(keep)))
+
+
 def singular_value_map(matrix, transform):
     """
     Return ``A diag(transform(sigma)) B^T`` for the thin SVD ``A diag(sigma) B^T`` of ``matrix``.
@@ -55,11 +77,8 @@ def singular_value_map(matrix, transform):
     rank : int, how many transformed values are positive
 
     """
-    sigma, right = gram_eigh(matrix)
-    new = np.asarray(transform(sigma), dtype=np.float64)
-    keep = (new > 0) & (sigma > 1e-12 * max(sigma[0], 1e-300))
-    mixing = (right[:, keep] * (new[keep] / sigma[keep])) @ right[:, keep].T
-    return matrix @ mixing.astype(matrix.dtype), sigma, int(np.count_nonzero(keep))
+    left, right_t, sigma, rank = mixing_factors(matrix.T @ matrix, transform)
+    return matrix @ (left @ right_t).astype(matrix.dtype), sigma, rank
 
 
 def thin_svd(matrix, rank=None, rtol=1e-6):

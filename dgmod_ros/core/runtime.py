@@ -39,3 +39,41 @@ def keep_freed_memory():
     ok = mallopt(_M_TRIM_THRESHOLD, 1024 * 1024 * 1024) == 1 and ok
     _applied = ok
     return ok
+
+
+_OPENBLAS_SETTERS = ('openblas_set_num_threads', 'openblas_set_num_threads64_',
+                     'scipy_openblas_set_num_threads', 'scipy_openblas_set_num_threads64_')
+
+
+def limit_blas_threads(count=1):
+    """
+    Set the thread count of every OpenBLAS loaded in this process (numpy's, scipy's).
+
+    The fused solver kernels run on numba's thread pool; OpenBLAS's own
+    threads, busy-waiting beside them between the sweep's small products,
+    made a sweep several times slower on the loaded two-core machine
+    (docs/solver.md). With the kernels owning the cores, the products are
+    cheaper single-threaded. Returns how many libraries took the setting
+    (0 where no OpenBLAS is loaded, for example a reference BLAS).
+    """
+    try:
+        with open('/proc/self/maps') as maps:
+            fields = [line.split() for line in maps]
+    except OSError:
+        return 0
+    paths = {f[-1] for f in fields
+             if len(f) == 6 and 'openblas' in f[-1].rsplit('/', 1)[-1].lower()
+             and '.so' in f[-1]}
+    limited = 0
+    for path in sorted(paths):
+        try:
+            library = ctypes.CDLL(path)
+        except OSError:
+            continue
+        for name in _OPENBLAS_SETTERS:
+            setter = getattr(library, name, None)
+            if setter is not None:
+                setter(int(count))
+                limited += 1
+                break
+    return limited

@@ -1,0 +1,144 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""The fused numba sweep against the literal numpy sweep, and kernels from two threads."""
+
+import ctypes
+import threading
+
+from dgmod_ros.core import kernels
+from dgmod_ros.core.dgmod import DualGraphMOD
+from dgmod_ros.core.runtime import limit_blas_threads
+from dgmod_ros.core.synthetic import synthetic_scene
+import numba
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+SHAPE = (36, 48)
+FRAMES = 24
+STATE = ('background', 'foreground', 'low_rank', 'noise', 'dual_low_rank', 'dual_noise')
+
+
+def scene_window(frames=FRAMES, seed=0):
+    scene = synthetic_scene(n_frames=frames, shape=SHAPE, seed=seed)
+    grey = scene.frames.mean(axis=3) / 255.0
+    return np.ascontiguousarray(grey.reshape(frames, -1).T, dtype=np.float32)
+
+
+def assert_same_iterates(a, b, atol):
+    for name in STATE:
+        x, y = getattr(a.state_, name), getattr(b.state_, name)
+        assert x.dtype == y.dtype == np.float32
+        assert np.abs(x - y).max() <= atol, name
+    assert np.allclose(a.state_.weights, b.state_.weights, atol=1e-4)
+    assert a.history_['rank'] == b.history_['rank']
+    for key in ('change_L', 'change_S', 'residual_U', 'residual_V'):
+        assert np.allclose(a.history_[key], b.history_[key], rtol=1e-3, atol=1e-7), key
+
+
+@pytest.mark.parametrize('options', [
+    {},                                        # the default: one gradient step, fused L-step
+    {'l_step': 'exact', 'inner_iter': 2},      # L-step in numpy, the rest fused
+    {'inner_iter': 2},
+    {'lambda1': 0.0},                          # no nuclear norm: identity prox
+    {'lambda2': 1.5, 'gamma1': 0.0},           # residual goes to V: the V-shrinkage matters
+])
+def test_fused_sweep_gives_the_numpy_iterates(options):
+    data = scene_window()
+    sweeps = 12
+    numpy_model = DualGraphMOD(engine='numpy', tol=1e-12, max_iter=sweeps, **options)
+    fused_model = DualGraphMOD(engine='fused', tol=1e-12, max_iter=sweeps, **options)
+    numpy_model.fit(data, SHAPE)
+    fused_model.fit(data, SHAPE)
+    assert numpy_model.n_iter_ == fused_model.n_iter_ == sweeps
+    # float32 rounding differs (fused sums, band order); 12 sweeps stay within 1e-4.
+    assert_same_iterates(numpy_model, fused_model, atol=1e-4)
+
+
+def test_fused_solve_stops_where_numpy_stops_and_warm_starts_alike():
+    data = scene_window()
+    first = [DualGraphMOD(engine=e, tol=1e-3).fit(data[:, :-4], SHAPE) for e in ('numpy', 'fused')]
+    assert first[0].info_ == first[1].info_ == 0
+    assert abs(first[0].n_iter_ - first[1].n_iter_) <= 1
+    init = first[0].state_.shifted(4)
+    second = [DualGraphMOD(engine=e, tol=1e-12, max_iter=5).fit(data[:, 4:], SHAPE, init=init)
+              for e in ('numpy', 'fused')]
+    assert_same_iterates(second[0], second[1], atol=1e-4)
+
+
+@pytest.mark.filterwarnings('ignore:overflow encountered', 'ignore:invalid value encountered')
+def test_non_finite_iterate_stops_both_engines_alike():
+    # A gradient step far beyond 1 / Lipschitz diverges to inf within a few sweeps.
+    data = scene_window()
+    models = [DualGraphMOD(engine=e, step_size=1e6, max_iter=50).fit(data, SHAPE)
+              for e in ('numpy', 'fused')]
+    for model in models:
+        assert model.info_ == -1
+        assert np.isfinite(model.background_).all() and np.isfinite(model.foreground_).all()
+    assert models[0].n_iter_ == models[1].n_iter_
+
+
+def test_diagonal_bands_reproduce_the_matrix():
+    rng = np.random.default_rng(3)
+    dense = np.where(rng.random((9, 9)) < 0.3, rng.standard_normal((9, 9)), 0.0)
+    for matrix in (sp.csr_matrix(dense), dense):
+        offsets, bands = kernels.diagonal_bands(matrix)
+        rebuilt = np.zeros_like(dense)
+        for k, offset in enumerate(offsets):
+            for i in range(9):
+                if 0 <= i + offset < 9:
+                    rebuilt[i, i + offset] = bands[k, i]
+        assert np.allclose(rebuilt, dense, atol=1e-6)
+
+
+def test_kernels_run_from_two_threads_at_once():
+    # The node calls kernels from its image callback and its solve thread;
+    # numba's workqueue layer would stop the process here.
+    data = [scene_window(seed=seed) for seed in (1, 2)]
+    alone = [DualGraphMOD(tol=1e-12, max_iter=8).fit(d, SHAPE) for d in data]
+    barrier = threading.Barrier(2)
+    together = [None, None]
+    errors = []
+
+    def solve(index):
+        try:
+            barrier.wait(timeout=30)
+            for _ in range(5):
+                together[index] = DualGraphMOD(tol=1e-12, max_iter=8).fit(data[index], SHAPE)
+        except Exception as error:      # reported below, in the main thread
+            errors.append(error)
+
+    threads = [threading.Thread(target=solve, args=(i,)) for i in (0, 1)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join(timeout=300)
+    assert not errors
+    assert numba.threading_layer() in ('tbb', 'omp')
+    for a, b in zip(alone, together):
+        assert_same_iterates(a, b, atol=1e-6)
+
+
+def test_cache_folder_defaults_to_the_user_cache(monkeypatch, tmp_path):
+    monkeypatch.setenv('XDG_CACHE_HOME', str(tmp_path))
+    assert kernels.default_cache_dir() == str(tmp_path / 'dgmod_ros' / 'numba')
+    assert numba.config.CACHE_DIR       # set before the first compiled call
+    assert numba.config.THREADING_LAYER == 'threadsafe'
+
+
+def test_openblas_runs_on_one_thread_after_a_fused_solve():
+    import scipy.linalg  # noqa: F401 (scipy's own OpenBLAS, loaded after the kernels)
+    DualGraphMOD(max_iter=1).fit(scene_window(), SHAPE)
+    getters = ('openblas_get_num_threads', 'openblas_get_num_threads64_',
+               'scipy_openblas_get_num_threads', 'scipy_openblas_get_num_threads64_')
+    with open('/proc/self/maps') as maps:
+        paths = {line.split()[-1] for line in maps
+                 if 'openblas' in line.lower() and '.so' in line}
+    counts = []
+    for path in paths:
+        library = ctypes.CDLL(path)
+        counts += [getattr(library, name)() for name in getters if hasattr(library, name)][:1]
+    if not counts:
+        pytest.skip('no OpenBLAS loaded (another BLAS: nothing to limit)')
+    assert set(counts) == {1}
+    assert limit_blas_threads(1) == len(counts)
