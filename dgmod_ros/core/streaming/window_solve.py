@@ -7,6 +7,7 @@ import time
 import numpy as np
 
 from .fast_path import background_basis
+from .foreground import pixel_noise
 from .results import BackgroundModel, SolverFailure
 
 
@@ -22,7 +23,10 @@ def warm_starts(snapshot):
     if (previous is None or previous.shape != snapshot.shape or not previous.states
             or any(s is None for s in previous.states)):
         return [None] * channels
-    shift = snapshot.first_id - previous.first_id
+    if snapshot.first_column is not None and previous.first_column is not None:
+        shift = snapshot.first_column - previous.first_column
+    else:
+        shift = snapshot.first_id - previous.first_id
     width = snapshot.data.shape[2]
     if not 0 <= shift < width or previous.states[0].frames != width:
         return [None] * channels
@@ -59,6 +63,11 @@ def solve_window(snapshot):
         states.append(getattr(fitted, 'state_', None))
         iterations = max(iterations, int(getattr(fitted, 'n_iter_', 0)))
         info = max(info, int(getattr(fitted, 'info_', 0)))
+    residuals = np.stack(residuals)
+    noise = None
+    if snapshot.decision != 'global':
+        noise = pixel_noise(residuals, snapshot.shape, snapshot.observed,
+                            uniform=snapshot.decision == 'uniform')
     rank = max(b.shape[1] for b in bases)
     basis = np.zeros((channels, rows * cols, rank), dtype=np.float32)
     for channel, channel_basis in enumerate(bases):
@@ -67,7 +76,8 @@ def solve_window(snapshot):
         basis=basis,
         background=np.stack(backgrounds, axis=1).reshape(rows, cols, channels),
         mean_background=np.stack(means, axis=1).reshape(rows, cols, channels),
-        threshold=snapshot.mask_rule.estimate_threshold(np.stack(residuals), snapshot.data),
+        threshold=snapshot.mask_rule.estimate_threshold(residuals, snapshot.data),
         shape=snapshot.shape, first_id=snapshot.first_id, last_id=snapshot.last_id,
         states=states, seconds=time.perf_counter() - started,
-        iterations=iterations, info=info, ticket=snapshot.ticket)
+        iterations=iterations, info=info, ticket=snapshot.ticket, noise=noise,
+        first_column=snapshot.first_column)
