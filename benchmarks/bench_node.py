@@ -22,7 +22,7 @@ import time
 from dgmod_ros.core.runtime import keep_freed_memory
 from dgmod_ros.core.synthetic import synthetic_scene
 from dgmod_ros.detector_node import DetectorNode
-from dgmod_ros.image_conversion import array_to_image_fields
+from dgmod_ros.image_conversion import fill_image
 import rclpy
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
@@ -60,9 +60,7 @@ def replay(method, seconds, rate, frames):
         time.sleep(0.01)
     messages = []
     for frame in frames:
-        msg = Image()
-        for name, value in array_to_image_fields(frame, 'rgb8').items():
-            setattr(msg, name, value)
+        msg = fill_image(Image(), frame, 'rgb8')
         msg.header.frame_id = 'camera'
         messages.append(msg)
     period = 1.0 / rate

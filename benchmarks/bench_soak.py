@@ -22,7 +22,7 @@ import time
 from dgmod_ros.core.runtime import keep_freed_memory
 from dgmod_ros.core.synthetic import synthetic_scene
 from dgmod_ros.detector_node import DetectorNode
-from dgmod_ros.image_conversion import array_to_image_fields
+from dgmod_ros.image_conversion import fill_image
 import numpy as np
 import rclpy
 from rclpy.context import Context
@@ -43,9 +43,7 @@ def resident_mb():
 
 
 def message(array, encoding):
-    msg = Image()
-    for name, value in array_to_image_fields(array, encoding).items():
-        setattr(msg, name, value)
+    msg = fill_image(Image(), array, encoding)
     msg.header.frame_id = 'camera'
     return msg
 

@@ -72,8 +72,9 @@ PARAMETERS = (
     Parameter('value_range', 0.0, 'pixel value meaning full scale (for example 5000.0 for '
               '16UC1 depth in mm); 0 uses the type range (floats: 1.0)', 0.0, 1e9),
     # Model (Algorithm 1).
-    Parameter('lambda1', 0.0, 'weight of the weighted nuclear norm; 0 = lambda2 * '
-              'sqrt(max(n, m))', 0.0, 1e6),
+    Parameter('lambda1', 0.0, 'weight of the weighted nuclear norm; 0 = automatic, lambda2 '
+              '* sqrt(max(n, m)) (as in the core; the model without the term is frpcag)',
+              0.0, 1e6),
     Parameter('lambda2', 0.5, 'weight of ||S||_1; below 1 so that S takes the foreground',
               1e-6, 0.999),
     Parameter('gamma1', 0.5, 'weight of the spatial graph term', 0.0, 1e3),

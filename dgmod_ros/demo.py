@@ -24,7 +24,7 @@ from .core.masks import overlay
 from .core.metrics import ConfusionCounts, iou, psnr
 from .core.runtime import keep_freed_memory
 from .core.synthetic import synthetic_scene
-from .image_conversion import array_to_image_fields, image_to_array
+from .image_conversion import fill_image, image_to_array
 from .inputs import BadInput, read_frames
 
 
@@ -94,9 +94,7 @@ def replay(frames, rate=30.0, **parameters):
         for index, frame in enumerate(frames):
             while time.monotonic() < start + index * period:
                 executor.spin_once(timeout_sec=0.002)
-            msg = Image()
-            for name, value in array_to_image_fields(frame, 'rgb8').items():
-                setattr(msg, name, value)
+            msg = fill_image(Image(), frame, 'rgb8')
             msg.header.stamp.sec, msg.header.stamp.nanosec = index, 0
             msg.header.frame_id = 'demo_camera'
             publisher.publish(msg)

@@ -29,7 +29,7 @@ from . import config
 from .core.masks import overlay
 from .core.preprocess import to_float_channels, to_uint8
 from .core.streaming import SolverFailure
-from .image_conversion import array_to_image_fields, image_to_array, ImageConversionError
+from .image_conversion import fill_image, image_to_array, ImageConversionError
 from .solve_worker import SolveWorker
 from .stats import DetectorStats
 
@@ -50,14 +50,6 @@ def _descriptor(spec):
         descriptor.floating_point_range = [FloatingPointRange(
             from_value=float(spec.low), to_value=float(spec.high), step=0.0)]
     return descriptor
-
-
-def _message(fields, header):
-    msg = Image()
-    msg.header = header
-    for name, value in fields.items():
-        setattr(msg, name, value)
-    return msg
 
 
 class DetectorNode(Node):
@@ -136,8 +128,7 @@ class DetectorNode(Node):
                                           throttle_duration_sec=_WARN_PERIOD)
                 return
             background = detector.background_image() if result.new_background else None
-        self._mask_pub.publish(_message(array_to_image_fields(result.mask, 'mono8'),
-                                        msg.header))
+        self._mask_pub.publish(fill_image(Image(), result.mask, 'mono8', msg.header))
         self._stats.masked(time.monotonic() - received)
         if result.reset:
             self._stats.window_reset()
@@ -185,11 +176,11 @@ class DetectorNode(Node):
         if pixels.shape[2] == 1:
             pixels = pixels[:, :, 0]
         encoding = 'mono8' if pixels.ndim == 2 else 'rgb8'
-        self._background_pub.publish(_message(array_to_image_fields(pixels, encoding), header))
+        self._background_pub.publish(fill_image(Image(), pixels, encoding, header))
 
     def _publish_overlay(self, image, order, value_range, mask, header):
         pixels = overlay(to_float_channels(image, order or 'rgb', 'rgb', value_range), mask)
-        self._overlay_pub.publish(_message(array_to_image_fields(pixels, 'rgb8'), header))
+        self._overlay_pub.publish(fill_image(Image(), pixels, 'rgb8', header))
 
     # ----------------------------------------------------------------- parameters
     def _check_parameters(self, parameters):
@@ -278,9 +269,9 @@ def main(args=None):
     try:
         node = DetectorNode()
         # The solves run in the node's own thread, so the executor only carries
-        # short callbacks. rclpy's MultiThreadedExecutor lost 6-35% of the
-        # frames of a 30 frames/s replay here (queue overflow during its
-        # stalls; rclpy#1452, #1223); the single-threaded one lost none.
+        # short callbacks. rclpy's MultiThreadedExecutor lost frames of a
+        # 30 frames/s replay here (queue overflow during its stalls; rclpy#1452,
+        # #1223; figures in docs/node.md); the single-threaded one lost none.
         executor = SingleThreadedExecutor()
         executor.add_node(node)
         executor.spin()

@@ -20,6 +20,7 @@ import cv2
 import numpy as np
 
 from .core.metrics import ConfusionCounts, GT_BACKGROUND, GT_SHADOW, psnr, relative_error
+from .core.preprocess import to_float_channels, to_uint8
 from .inputs import BadInput, read_frames
 from .sequence import results
 
@@ -54,12 +55,8 @@ def load_dataset(path):
 
 
 def _grey(frame):
-    image = frame.image
-    if image.ndim == 3:
-        code = cv2.COLOR_BGR2GRAY if frame.channel_order == 'bgr' else cv2.COLOR_RGB2GRAY
-        image = cv2.cvtColor(image[:, :, :3], code)
-    return image.astype(np.float32) / float(np.iinfo(image.dtype).max
-                                            if image.dtype.kind in 'ui' else 1.0)
+    """Return a frame's luma in [0, 1], the conversion every method's input goes through."""
+    return to_float_channels(frame.image, frame.channel_order or 'rgb', 'gray')[:, :, 0]
 
 
 def reference_background(frames, dataset):
@@ -85,7 +82,7 @@ def evaluate_method(frames, dataset, values, mode):
     started = time.perf_counter()
     for frame, mask, background, _ in results(frames, values, mode):
         if background is not None:
-            grey = background.mean(axis=2) if background.shape[2] == 3 else background[:, :, 0]
+            grey = to_float_channels(background, 'rgb', 'gray')[:, :, 0]
             background_sum = grey if background_sum is None else background_sum + grey
             background_count += 1
         if dataset.first <= frame.index <= dataset.last:
@@ -168,9 +165,8 @@ def _label(image, text):
 
 def _write_figures(out, dataset, reference, backgrounds, examples):
     """Figure 1: mean background per method; figure 2: first and last scored masks."""
-    tiles = [_label((np.clip(reference, 0, 1) * 255).astype(np.uint8), 'reference')]
-    tiles += [_label((np.clip(b, 0, 1) * 255).astype(np.uint8), m)
-              for m, b in backgrounds.items()]
+    tiles = [_label(to_uint8(reference), 'reference')]
+    tiles += [_label(to_uint8(b), m) for m, b in backgrounds.items()]
     cv2.imwrite(str(out / f'figure1_backgrounds_{dataset.name}.png'), np.concatenate(tiles, 1))
     truth = [cv2.imread(str(dataset.truths[i]), cv2.IMREAD_GRAYSCALE)
              for i in (dataset.first, dataset.last)]

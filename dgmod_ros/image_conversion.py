@@ -117,3 +117,29 @@ def array_to_image_fields(image, encoding):
     return {'height': height, 'width': width, 'encoding': encoding,
             'is_bigendian': int(not np.little_endian),
             'step': width * channels * image.dtype.itemsize, 'data': image.tobytes()}
+
+
+def fill_image(msg, image, encoding, header=None):
+    """
+    Fill an Image message (or any object with its fields) from an array; return it.
+
+    The one place that builds ``sensor_msgs/Image`` messages: the node's
+    outputs, the demo's camera, the benchmarks and the tests all use it.
+
+    Parameters
+    ----------
+    msg : sensor_msgs.msg.Image
+        A new message; its pixel fields are replaced.
+    image : ndarray
+        Pixels with the dtype and channel count of ``encoding``.
+    encoding : str
+        One of :data:`ENCODINGS`.
+    header : std_msgs.msg.Header or None
+        Copied into the message when given.
+
+    """
+    for name, value in array_to_image_fields(image, encoding).items():
+        setattr(msg, name, value)
+    if header is not None:
+        msg.header = header
+    return msg

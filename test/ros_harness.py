@@ -5,7 +5,7 @@
 import time
 
 from dgmod_ros.detector_node import DetectorNode
-from dgmod_ros.image_conversion import array_to_image_fields, image_to_array
+from dgmod_ros.image_conversion import fill_image, image_to_array
 import rclpy
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
@@ -16,9 +16,7 @@ from sensor_msgs.msg import Image
 
 def image_message(array, encoding, stamp_ns=0, frame_id='camera'):
     """Build a sensor_msgs/Image from an array already in ``encoding``'s layout."""
-    msg = Image()
-    for name, value in array_to_image_fields(array, encoding).items():
-        setattr(msg, name, value)
+    msg = fill_image(Image(), array, encoding)
     msg.header.stamp.sec = stamp_ns // 10**9
     msg.header.stamp.nanosec = stamp_ns % 10**9
     msg.header.frame_id = frame_id

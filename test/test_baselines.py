@@ -9,6 +9,7 @@ from dgmod_ros.core.baselines.median import TemporalMedian
 from dgmod_ros.core.baselines.proximal import project_l1_ball, project_nuclear_ball
 from dgmod_ros.core.baselines.spcp import SplitSPCP
 from dgmod_ros.core.baselines.spgl1 import SPGL1RPCA
+from dgmod_ros.core.dgmod import DualGraphMOD
 from dgmod_ros.core.subtractors import OpenCVWindowModel
 from dgmod_ros.core.synthetic import textured_background
 import numpy as np
@@ -78,7 +79,7 @@ def test_lago_reproduces_fastrpca_escalator_reference(data_dir):
     video = scipy.io.loadmat(data_dir / 'escalator' / 'escalator_data.mat')['X']
     data = video.astype(np.float32)                      # 20800 x 200, 0..255
     model = LAGO(lambda_l=115.0, lambda_s=0.8, tol=1e-8, max_iter=200).fit(data, (130, 160))
-    # shared/docs/baselines.md 1.7 (float64, exact SVD): objective 5.6661e7 at
+    # fastRPCA's own run (float64, exact SVD): objective 5.6661e7 at
     # 198 iterations, rank 69, nnz(S)/N 0.540, relative residual 4.66e-3.
     # Measured here (float32): 5.6806e7 (+0.26%), rank 70, 0.540, 4.66e-3.
     assert model.objective_ == pytest.approx(5.6661e7, rel=5e-3)
@@ -86,3 +87,27 @@ def test_lago_reproduces_fastrpca_escalator_reference(data_dir):
     assert np.count_nonzero(model.foreground_) / data.size == pytest.approx(0.540, abs=0.01)
     residual = np.linalg.norm(model.background_ + model.foreground_ - data) / np.linalg.norm(data)
     assert residual == pytest.approx(4.66e-3, rel=0.05)
+
+
+@pytest.mark.parametrize('model', [DualGraphMOD(), FRPCAG(), LAGO(), SplitSPCP(), SPGL1RPCA(),
+                                   InexactALM(), TemporalMedian(), OpenCVWindowModel('mog2')],
+                         ids=lambda model: type(model).__name__)
+def test_every_window_method_refuses_bad_windows_the_same_way(model):
+    data = np.full((SHAPE[0] * SHAPE[1], 4), 0.5, np.float32)
+    data[7, 2] = np.nan
+    with pytest.raises(ValueError, match='NaN or Inf'):
+        model.fit(data, SHAPE)
+    with pytest.raises(ValueError, match='does not match'):
+        model.fit(np.zeros((10, 4), np.float32), SHAPE)
+    with pytest.raises(ValueError, match='at least 2 frames'):
+        model.fit(np.zeros((SHAPE[0] * SHAPE[1], 1), np.float32), SHAPE)
+
+
+def test_lambda1_zero_means_automatic_and_frpcag_has_no_nuclear_norm():
+    background, outliers = low_rank_plus_sparse()
+    data = background + outliers
+    automatic = np.sqrt(max(data.shape)) * 0.5
+    for value in (None, 0.0):
+        assert DualGraphMOD(lambda1=value, max_iter=2).fit(data, SHAPE).lambda1_ == \
+            pytest.approx(automatic)
+    assert FRPCAG(max_iter=2).fit(data, SHAPE).lambda1_ == 0.0

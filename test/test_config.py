@@ -3,6 +3,7 @@
 from pathlib import Path
 
 from dgmod_ros import config
+from dgmod_ros.core.streaming import StreamingDetector
 import pytest
 
 REPO = Path(__file__).resolve().parents[1]
@@ -22,7 +23,8 @@ def test_parameter_file_lists_every_parameter_with_its_default():
 def test_every_method_builds_a_detector(method):
     values = dict(config.DEFAULTS, method=method)
     detector = config.build_detector(values)
-    assert hasattr(detector, 'process') and hasattr(detector, 'push')
+    assert isinstance(detector, StreamingDetector)          # the full contract
+    assert isinstance(detector, config.detector_class(values))
 
 
 @pytest.mark.parametrize('change, message', [

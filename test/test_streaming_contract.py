@@ -83,7 +83,8 @@ def test_push_solve_install_sequence(method, frames):
 
 
 @pytest.mark.parametrize('method', METHODS)
-def test_solve_finished_after_a_reconfigure_is_discarded(method, frames):
+@pytest.mark.parametrize('change', ['configure', 'reset'])
+def test_solve_finished_after_a_reconfigure_is_discarded(method, change, frames):
     detector = config.build_detector(_values(method))
     in_flight = None
     for frame in frames:
@@ -91,7 +92,10 @@ def test_solve_finished_after_a_reconfigure_is_discarded(method, frames):
         if detector.solve_due():
             in_flight = detector.solve(detector.snapshot())
             break
-    detector.configure(**config.detector_settings(_values(method, mask_k=4.0)))
+    if change == 'configure':
+        detector.configure(**config.detector_settings(_values(method, mask_k=4.0)))
+    else:
+        detector.reset()
     if in_flight is None:                      # a subtractor: another detector's solve
         _, snapshot = _window_with_solve_in_flight('median', frames)
         in_flight = config.build_detector(_values('median')).solve(snapshot)

@@ -7,7 +7,9 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .graphs import spatial_laplacian, temporal_laplacian
-from .linalg import drop_oldest, relative_change, shrink, singular_value_map
+from .linalg import (drop_oldest, relative_change, shrink, singular_value_map,
+                     top_singular_value)
+from .window_data import check_window_data
 
 
 @dataclass
@@ -70,7 +72,8 @@ class DualGraphMOD:
     ``Phi_s`` and ``Phi_t`` are the normalised Laplacians of the 4-neighbour
     patch-similarity pixel graph and of the nearest-frames graph
     (:mod:`dgmod_ros.core.graphs`). The steps are those of
-    ``docs/algorithm.md``, which corrects the paper's printed S- and V-steps.
+    ``docs/solver.md`` (one ADMM sweep), which corrects the paper's printed S-
+    and V-steps.
 
     Because both the fidelity and the foreground terms are l1, the optimum puts
     the whole residual ``D - L`` into ``S`` when ``lambda2 < 1`` and into
@@ -79,8 +82,10 @@ class DualGraphMOD:
     Parameters
     ----------
     lambda1 : float or None, default=None
-        Weight of the weighted nuclear norm. None: ``lambda2 * sqrt(max(n, m))``,
-        the balance of classical PCP. 0 drops the term (the FRPCAG model).
+        Weight of the weighted nuclear norm. None or 0: automatic,
+        ``lambda2 * sqrt(max(n, m))``, the balance of classical PCP (0 means
+        automatic in the node's parameter table too). The model without the
+        term is :class:`~dgmod_ros.core.baselines.frpcag.FRPCAG`.
     lambda2 : float, default=0.5
         Weight of ``||S||_1``; must be below 1 (see above).
     gamma1 : float, default=0.5
@@ -144,11 +149,14 @@ class DualGraphMOD:
     References
     ----------
     .. [1] J. Qin, R. Shen, R. Zhu, B. Xie, "Robust Dual-Graph Regularized
-       Moving Object Detection", arXiv:2204.11939, 2022 (``shared/paper``).
+       Moving Object Detection", arXiv:2204.11939, 2022.
     .. [2] S. Gu, L. Zhang, W. Zuo, X. Feng, "Weighted Nuclear Norm Minimization
        with Application to Image Denoising", CVPR 2014.
 
     """
+
+    #: Whether the objective has the weighted nuclear norm (FRPCAG's has not).
+    _nuclear_norm = True
 
     def __init__(self, lambda1=None, lambda2=0.5, gamma1=0.5, gamma2=0.5, rho1=20.0, rho2=20.0,
                  weight_scale=None, h_s=None, h_t=None, patch_size=3, smoothing_sigma=0.0,
@@ -207,18 +215,7 @@ class DualGraphMOD:
 
     def _validate(self, data, frame_shape):
         self.check_parameters()
-        data = np.asarray(data)
-        if data.ndim != 2:
-            raise ValueError(f'data must be 2-D (pixels x frames), got shape {data.shape}')
-        n, m = data.shape
-        if m < 2:
-            raise ValueError(f'data must hold at least 2 frames (columns), got {m}')
-        if len(frame_shape) != 2 or frame_shape[0] * frame_shape[1] != n:
-            raise ValueError(f'frame_shape {tuple(frame_shape)} does not match {n} pixels')
-        data = np.asarray(data, dtype=np.float32)
-        if not np.all(np.isfinite(data)):
-            raise ValueError('data contains NaN or Inf')
-        return data
+        return check_window_data(data, frame_shape)
 
     # ------------------------------------------------------------------ steps
     def _initial_state(self, data):
@@ -328,14 +325,14 @@ class DualGraphMOD:
         n, m = data.shape
         if init is not None and init.background.shape != data.shape:
             raise ValueError(f'init state has shape {init.background.shape}, data {data.shape}')
-        self.lambda1_ = (self.lambda1 if self.lambda1 is not None
-                         else self.lambda2 * np.sqrt(max(n, m)))
+        if not self._nuclear_norm:
+            self.lambda1_ = 0.0
+        else:       # None and 0 both mean automatic, as in the parameter table
+            self.lambda1_ = self.lambda1 or self.lambda2 * np.sqrt(max(n, m))
         ops = self.build_operators(data, frame_shape)
         data_norm = float(np.linalg.norm(data)) or 1.0
         if self.weight_scale is None:
-            # ||D||_2 from the Gram matrix's top eigenvalue: an m x m problem.
-            top = np.linalg.eigvalsh((data.T @ data).astype(np.float64))[-1]
-            self.weight_scale_ = 0.1 * float(np.sqrt(max(top, 0.0))) or 1.0
+            self.weight_scale_ = 0.1 * top_singular_value(data) or 1.0
         else:
             self.weight_scale_ = float(self.weight_scale)
 

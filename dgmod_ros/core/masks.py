@@ -15,11 +15,11 @@ deviation from the median; 1.4826 makes it the standard deviation for
 Gaussian noise). When the window's frames are given too, ``sigma`` is at most
 ``1.4826 * MAD(d_t - d_(t-1)) / sqrt(2)``, the same estimate from consecutive
 frame differences, which does not depend on how well ``L`` fits: a background
-that lags behind a light change inflates the residual's MAD (measured: tau
-0.49 instead of 0.10 three solves after half a room lit up, and the person
-was missed), never the differences'. The magnitude is resized to the output size (bilinear) before
-thresholding, then an optional morphological opening (speckle) and closing
-(holes) with an elliptic ``morph_size x morph_size`` kernel is applied.
+that lags behind a light change inflates the residual's MAD, never the
+differences' (``docs/solver.md`` has the case that showed it). The magnitude
+is resized to the output size (bilinear) before thresholding, then an
+optional morphological opening (speckle) and closing (holes) with an elliptic
+``morph_size x morph_size`` kernel is applied.
 """
 
 import cv2

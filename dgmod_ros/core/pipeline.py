@@ -3,12 +3,12 @@
 """Offline separation of a whole sequence: batch tiling and the streaming loop."""
 
 from dataclasses import dataclass
-import time
 
 import numpy as np
 
 from .masks import MaskRule
-from .preprocess import processing_shape, resize, to_float_channels
+from .preprocess import frame_columns
+from .separation import separate_channels
 
 
 @dataclass
@@ -84,30 +84,23 @@ def batch_separate(frames, model, window=60, scale=0.5, color='gray', mask_rule=
     if not frames:
         return
     input_shape = np.asarray(frames[0]).shape[:2]
-    rows, cols = processing_shape(input_shape, scale)
     for start, stop, first_new in window_tiles(len(frames), int(window)):
-        stack = []
+        columns = []
         for frame in frames[start:stop]:
             if np.asarray(frame).shape[:2] != input_shape:
                 raise ValueError(f'frame size changed from {input_shape} to '
                                  f'{np.asarray(frame).shape[:2]}')
-            channels = to_float_channels(frame, channel_order, color, value_range)
-            stack.append(resize(channels, (rows, cols)).reshape(rows * cols, -1))
-        data = np.stack(stack, axis=2)                              # (n, C, m)
-        started = time.perf_counter()
-        magnitudes, backgrounds, residuals, iterations = [], [], [], 0
-        for channel in range(data.shape[1]):
-            fitted = model.fit(np.ascontiguousarray(data[:, channel, :]), (rows, cols))
-            magnitudes.append(np.abs(np.asarray(fitted.foreground_, dtype=np.float32)))
-            background = np.asarray(fitted.background_, dtype=np.float32)
-            backgrounds.append(background.mean(axis=1))
-            residuals.append(data[:, channel, :] - background)
-            iterations = max(iterations, int(getattr(fitted, 'n_iter_', 0)))
-        record = SolveRecord(first=start, last=stop - 1, iterations=iterations,
-                             seconds=time.perf_counter() - started)
-        magnitude = np.max(magnitudes, axis=0)
-        threshold = rule.estimate_threshold(np.stack(residuals), np.moveaxis(data, 1, 0))
-        mean_background = np.stack(backgrounds, axis=1).reshape(rows, cols, -1)
+            frame_data, shape = frame_columns(frame, scale, color, channel_order, value_range)
+            columns.append(frame_data)
+        data = np.stack(columns, axis=2)                            # (C, n, m)
+        rows, cols = shape[:2]
+        separated = separate_channels(model, data, (rows, cols))
+        record = SolveRecord(first=start, last=stop - 1, iterations=separated.iterations,
+                             seconds=separated.seconds)
+        magnitude = np.max([np.abs(s) for s in separated.foregrounds], axis=0)
+        threshold = separated.threshold(rule, data)
+        mean_background = np.stack([b.mean(axis=1) for b in separated.backgrounds],
+                                   axis=1).reshape(rows, cols, -1)
         for index in range(first_new, stop):
             mask = rule.apply(magnitude[:, index - start].reshape(rows, cols), threshold,
                               input_shape)

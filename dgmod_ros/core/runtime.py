@@ -16,8 +16,8 @@ def keep_freed_memory():
 
     By default glibc serves every allocation above 128 KiB with a fresh
     ``mmap`` and unmaps it on free, so each n x m temporary of an ADMM sweep
-    pays a page fault per 4 KiB on first touch: measured here, a 7 MB copy
-    took 6 ms instead of 1 ms and a sweep 1.4 times longer. Raising the
+    pays a page fault per 4 KiB on first touch (``docs/solver.md`` has the
+    measured cost). Raising the
     mmap and trim thresholds keeps such blocks in the heap for reuse; resident
     memory then stays at the peak working set, which a long-running node
     reaches anyway. Call once at program start (the command line, the node

@@ -10,6 +10,7 @@ from .preprocess import processing_shape, resize, to_float_channels, to_uint8
 from .streaming.contract import StreamingDetector
 from .streaming.results import FrameResult, SolverFailure
 from .streaming.settings import assign_validated, check_scale_and_color
+from .window_data import check_window_data
 
 _FACTORIES = {
     'mog2': cv2.createBackgroundSubtractorMOG2,
@@ -178,7 +179,7 @@ class OpenCVWindowModel:
         """Train on the window's frames, then mask each (``init`` is unused)."""
         if self.kind not in _FACTORIES:
             raise ValueError(f"kind must be 'mog2' or 'knn', got {self.kind!r}")
-        data = np.asarray(data, dtype=np.float32)
+        data = check_window_data(data, frame_shape)
         rows, cols = frame_shape
         frames = to_uint8(data).T.reshape(-1, rows, cols)
         subtractor = _FACTORIES[self.kind]()

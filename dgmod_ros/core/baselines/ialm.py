@@ -4,9 +4,9 @@
 
 import numpy as np
 
-from .lago import _checked
 from .proximal import singular_value_threshold
-from ..linalg import shrink
+from ..linalg import shrink, top_singular_value
+from ..window_data import check_window_data
 
 
 class InexactALM:
@@ -43,10 +43,9 @@ class InexactALM:
 
     def fit(self, data, frame_shape, init=None):
         """Separate one window (n pixels x m frames); ``init`` is unused."""
-        data = _checked(data, frame_shape)
+        data = check_window_data(data, frame_shape)
         lam = self.lam if self.lam is not None else 1.0 / np.sqrt(max(data.shape))
-        norm_two = float(np.sqrt(max(np.linalg.eigvalsh(
-            (data.T @ data).astype(np.float64))[-1], 0.0)))
+        norm_two = top_singular_value(data)
         norm_fro = float(np.linalg.norm(data)) or 1.0
         dual = data / max(norm_two, float(np.abs(data).max()) / lam, 1e-30)
         mu = 1.25 / max(norm_two, 1e-30)

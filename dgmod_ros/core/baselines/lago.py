@@ -5,7 +5,8 @@
 import numpy as np
 
 from .proximal import quasi_newton_sls, singular_value_threshold
-from ..linalg import shrink
+from ..linalg import gram_eigh, shrink
+from ..window_data import check_window_data
 
 
 class LAGO:
@@ -29,7 +30,7 @@ class LAGO:
     tol : float, default=1e-6
         Relative change of ``||L + S - D||_F`` that stops the iteration.
         fastRPCA's default for video-sized problems (1e-3) stops on a
-        high-rank early iterate (``shared/docs/baselines.md`` 3.3).
+        high-rank early iterate (``docs/evaluation.md``).
     max_iter : int, default=200
         fastRPCA's iteration limit for video-sized problems.
 
@@ -48,7 +49,7 @@ class LAGO:
 
     def fit(self, data, frame_shape, init=None):
         """Separate one window (n pixels x m frames); ``init`` is unused."""
-        data = _checked(data, frame_shape)
+        data = check_window_data(data, frame_shape)
         lambda_s = (self.lambda_s if self.lambda_s is not None
                     else self.lambda_l / np.sqrt(max(data.shape)))
         if not (self.lambda_l > 0 and lambda_s > 0):
@@ -67,15 +68,4 @@ class LAGO:
 
 
 def _nuclear_norm(matrix):
-    eigval = np.linalg.eigvalsh((matrix.T @ matrix).astype(np.float64))
-    return float(np.sqrt(np.clip(eigval, 0.0, None)).sum())
-
-
-def _checked(data, frame_shape):
-    data = np.asarray(data, dtype=np.float32)
-    if data.ndim != 2 or data.shape[0] != frame_shape[0] * frame_shape[1] or data.shape[1] < 2:
-        raise ValueError(f'data of shape {data.shape} does not match frame_shape '
-                         f'{tuple(frame_shape)} with at least 2 frames')
-    if not np.all(np.isfinite(data)):
-        raise ValueError('data contains NaN or Inf')
-    return data
+    return float(gram_eigh(matrix, vectors=False).sum())

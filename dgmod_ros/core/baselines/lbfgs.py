@@ -16,8 +16,8 @@ def lbfgs(objective, start, memory=5, max_iter=100, grad_tol=1e-10, prog_tol=1e-
     Armijo condition (c1 = 1e-4) holds, as minFunc does. Stops when
     ``max |g| <= grad_tol``, when the value changes by less than ``prog_tol``
     relative, or after ``max_iter`` iterations. scipy's L-BFGS-B spent more time
-    in its bound-constrained bookkeeping (21 ms a call on 192,000 unknowns) than
-    this whole update takes.
+    in its bound-constrained bookkeeping than this whole update takes
+    (``docs/evaluation.md``).
 
     Returns
     -------

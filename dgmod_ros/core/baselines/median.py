@@ -4,6 +4,8 @@
 
 import numpy as np
 
+from ..window_data import check_window_data
+
 
 class TemporalMedian:
     """
@@ -14,10 +16,7 @@ class TemporalMedian:
 
     def fit(self, data, frame_shape, init=None):
         """Separate one window (``init`` is accepted for interface parity and unused)."""
-        data = np.asarray(data, dtype=np.float32)
-        if data.ndim != 2 or data.shape[0] != frame_shape[0] * frame_shape[1]:
-            raise ValueError(f'data of shape {data.shape} does not match frame_shape '
-                             f'{tuple(frame_shape)}')
+        data = check_window_data(data, frame_shape)
         column = np.median(data, axis=1, keepdims=True)
         self.background_ = np.repeat(column, data.shape[1], axis=1)
         self.foreground_ = data - self.background_

@@ -6,9 +6,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .lago import _checked
 from .lbfgs import lbfgs
 from ..linalg import drop_oldest, shrink
+from ..window_data import check_window_data
 
 
 @dataclass
@@ -53,17 +53,16 @@ class SplitSPCP:
     lambda_s : float or None, default=None
         As LAGO: None is ``lambda_l / sqrt(max(n, m))``.
     max_iter : int, default=100
-        L-BFGS iterations. fastRPCA's demo runs 500; on a 30-frame IBMtest2
-        window at half size the objective after 100 is within 0.07% of the
-        converged one (236.18 against 236.04 after 385), at a quarter of the
-        time. A warm start (``init``, the previous window's factors) stops
-        earlier on the progress test.
+        L-BFGS iterations. fastRPCA's demo runs 500; 100 end within 0.1% of
+        the converged objective at a quarter of the time (``docs/evaluation.md``).
+        A warm start (``init``, the previous window's factors) stops earlier on
+        the progress test.
     tol : float, default=1e-10
         L-BFGS gradient and progress tolerance (fastRPCA's demo ``optTol``,
         ``progTol``).
     memory : int, default=5
-        L-BFGS memory; fastRPCA's demo uses 1, which ends 0.1% higher after
-        100 iterations on the same window (236.47).
+        L-BFGS memory; fastRPCA's demo uses 1, which ends higher after 100
+        iterations (``docs/evaluation.md``).
     random_state : int, default=0
         Seed of the start.
 
@@ -86,7 +85,7 @@ class SplitSPCP:
 
     def fit(self, data, frame_shape, init=None):
         """Separate one window (n pixels x m frames), from ``init`` factors if given."""
-        data = _checked(data, frame_shape).astype(np.float64)
+        data = check_window_data(data, frame_shape).astype(np.float64)
         n, m = data.shape
         k = int(min(self.rank, n, m))
         if k < 1:

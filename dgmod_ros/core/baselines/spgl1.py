@@ -4,8 +4,9 @@
 
 import numpy as np
 
-from .lago import _checked
 from .proximal import project_l1_ball, project_nuclear_ball, quasi_newton_sls
+from ..linalg import top_singular_value
+from ..window_data import check_window_data
 
 
 class SPGL1RPCA:
@@ -61,7 +62,7 @@ class SPGL1RPCA:
 
     def fit(self, data, frame_shape, init=None):
         """Separate one window (n pixels x m frames); ``init`` is unused."""
-        data = _checked(data, frame_shape)
+        data = check_window_data(data, frame_shape)
         lam = self.lam
         epsilon = self.epsilon_rel * float(np.linalg.norm(data))
         low_rank = np.repeat(np.median(data, axis=1, keepdims=True), data.shape[1], axis=1)
@@ -96,9 +97,7 @@ class SPGL1RPCA:
     def _newton_step(tau, gradient, epsilon, lam):
         """Return the damped Newton update of tau on ``rho(tau) = epsilon``."""
         rho = float(np.linalg.norm(gradient))
-        gram = (gradient.T @ gradient).astype(np.float64)
-        gauge = np.sqrt(max(np.linalg.eigvalsh(gram)[-1], 0.0)) + \
-            float(np.abs(gradient).max()) / lam
+        gauge = top_singular_value(gradient) + float(np.abs(gradient).max()) / lam
         if gauge <= 0:
             return tau
         return float(np.clip(tau + 0.99 * (rho - epsilon) * rho / gauge, tau / 10, 1e10))

@@ -9,6 +9,7 @@ import numpy as np
 from .fast_path import background_basis
 from .foreground import pixel_noise
 from .results import BackgroundModel, SolverFailure
+from ..separation import separate_channels
 
 
 def warm_starts(snapshot):
@@ -45,39 +46,30 @@ def solve_window(snapshot):
     """
     rows, cols, channels = snapshot.shape
     started = time.perf_counter()
-    bases, backgrounds, means, residuals, states = [], [], [], [], []
-    iterations, info = 0, 0
-    for channel, init in enumerate(warm_starts(snapshot)):
-        data = snapshot.data[channel]
-        try:
-            fitted = snapshot.model.fit(data, (rows, cols), init=init)
-        except (ValueError, FloatingPointError, np.linalg.LinAlgError) as error:
-            raise SolverFailure(f'window solve failed: {error}') from error
-        background = np.asarray(fitted.background_, dtype=np.float32)
-        if not np.all(np.isfinite(background)) or getattr(fitted, 'info_', 0) < 0:
-            raise SolverFailure('window solve produced non-finite values')
-        bases.append(background_basis(background, int(snapshot.basis_rank)))
-        backgrounds.append(background[:, -1])
-        means.append(background.mean(axis=1))
-        residuals.append(data - background)
-        states.append(getattr(fitted, 'state_', None))
-        iterations = max(iterations, int(getattr(fitted, 'n_iter_', 0)))
-        info = max(info, int(getattr(fitted, 'info_', 0)))
-    residuals = np.stack(residuals)
+    try:
+        separated = separate_channels(snapshot.model, snapshot.data, (rows, cols),
+                                      warm_starts(snapshot))
+    except (ValueError, FloatingPointError, np.linalg.LinAlgError) as error:
+        raise SolverFailure(f'window solve failed: {error}') from error
+    backgrounds = separated.backgrounds
+    if separated.diverged or not all(np.all(np.isfinite(b)) for b in backgrounds):
+        raise SolverFailure('window solve produced non-finite values')
     noise = None
     if snapshot.decision != 'global':
-        noise = pixel_noise(residuals, snapshot.shape, snapshot.observed,
+        noise = pixel_noise(separated.residuals, snapshot.shape, snapshot.observed,
                             uniform=snapshot.decision == 'uniform')
-    rank = max(b.shape[1] for b in bases)
-    basis = np.zeros((channels, rows * cols, rank), dtype=np.float32)
+    bases = [background_basis(b, int(snapshot.basis_rank)) for b in backgrounds]
+    basis = np.zeros((channels, rows * cols, max(b.shape[1] for b in bases)), dtype=np.float32)
     for channel, channel_basis in enumerate(bases):
         basis[channel, :, :channel_basis.shape[1]] = channel_basis
     return BackgroundModel(
         basis=basis,
-        background=np.stack(backgrounds, axis=1).reshape(rows, cols, channels),
-        mean_background=np.stack(means, axis=1).reshape(rows, cols, channels),
-        threshold=snapshot.mask_rule.estimate_threshold(residuals, snapshot.data),
+        background=np.stack([b[:, -1] for b in backgrounds], axis=1).reshape(
+            rows, cols, channels),
+        mean_background=np.stack([b.mean(axis=1) for b in backgrounds], axis=1).reshape(
+            rows, cols, channels),
+        threshold=separated.threshold(snapshot.mask_rule, snapshot.data),
         shape=snapshot.shape, first_id=snapshot.first_id, last_id=snapshot.last_id,
-        states=states, seconds=time.perf_counter() - started,
-        iterations=iterations, info=info, ticket=snapshot.ticket, noise=noise,
-        first_column=snapshot.first_column)
+        states=separated.states, seconds=time.perf_counter() - started,
+        iterations=separated.iterations, info=separated.info, ticket=snapshot.ticket,
+        noise=noise, first_column=snapshot.first_column)
