@@ -80,6 +80,18 @@ def main():
         total += ms
         print(f'  {name:45s} {ms:7.2f} ms per frame')
     print(f'  {"per-frame path, total":45s} {total:7.2f} ms per frame')
+    # The earlier default per-frame path in the same run, as the reference
+    # (grey projection on one channel's basis, one threshold, 3 x 3 morphology).
+    grey, _ = frame_columns(frame, detector.scale, 'gray', 'rgb', None)
+    rule = detector.mask_rule_
+
+    def earlier_path():
+        residual = grey - robust_projection(model.basis[1:2], grey)
+        magnitude = np.abs(residual).max(axis=0).reshape(shape[:2])
+        rule.apply(magnitude, model.threshold, detector.input_shape_)
+
+    print(f'  {"reference: earlier grey path, same run":45s} '
+          f'{median_ms(earlier_path, args.repeats):7.2f} ms per frame')
     solve = median_ms(lambda: detector.solve(snapshot), max(3, args.repeats // 10))
     noise = median_ms(lambda: pixel_noise(residual, shape, snapshot.observed),
                       max(3, args.repeats // 10))
