@@ -15,10 +15,18 @@ $(STAMP): requirements.txt setup.py
 	$(PY) -m pip install --quiet -e .
 	touch $(STAMP)
 
+# numba compiles the solver's kernels on first use (tens of seconds on two
+# cores, holding the GIL); compiling them here, into the on-disk cache, keeps
+# that out of the node's first solve and out of the tests' time-outs. A warm
+# cache makes this a one-second load.
+KERNELS := $(PY) -c 'from dgmod_ros.core.kernels import compile_all; compile_all()'
+
 demo: $(STAMP)
+	$(KERNELS)
 	$(PY) -m dgmod_ros.demo $(DEMO_ARGS)
 
 test: $(STAMP)
+	$(KERNELS)
 	$(PY) -m pytest -q test $(PYTEST_ARGS)
 
 bench: $(STAMP)

@@ -52,7 +52,7 @@ PARAMETERS = (
     Parameter('stride', 10, 'buffered frames between window solves (<= window)', 1, 300),
     Parameter('scale', 0.5, 'processing scale of frames; masks come back at input size',
               0.05, 1.0),
-    Parameter('color', 'gray', 'gray: one luma channel; rgb: each channel solved, fused by '
+    Parameter('color', 'rgb', 'gray: one luma channel; rgb: each channel solved, fused by '
               'the largest magnitude', choices=('gray', 'rgb')),
     Parameter('min_frames', 5, 'frames before the first solve (<= window); until then masks '
               'use the per-pixel median of the buffer', 2, 300),
@@ -61,6 +61,12 @@ PARAMETERS = (
     Parameter('global_change_fraction', 0.7, 'foreground share of two consecutive frames '
               'that restarts the window (light switched, exposure jump); 1.0 disables',
               0.01, 1.0),
+    Parameter('memory_spacing', 10, 'frames between admissions to the full window, which '
+              'then spans window * memory_spacing frames; 1 = consecutive frames', 1, 1000),
+    Parameter('conditional_update', True, 'admit frames with their foreground replaced by the '
+              'background, so that a person who stops stays foreground'),
+    Parameter('absorb_frames', 300, 'foreground older than this many frames enters the '
+              'window as it is (a left object then joins the background)', 1, 1000000),
     Parameter('motion_threshold', 0.0, 'frames whose mean absolute change to the last '
               'buffered frame is below this are masked but not buffered; 0 buffers all',
               0.0, 1.0),
@@ -97,6 +103,16 @@ PARAMETERS = (
               'stream mode): each solve starts from the last, so sweeps add up over '
               'overlapping windows', 1, 10000),
     # Masks.
+    Parameter('decision', 'adaptive', 'adaptive: each pixel against pixel_k times its own noise '
+              "level from the window's residual; uniform: one level for all pixels; global: "
+              'the mask_* rule (one threshold, morphology)',
+              choices=('adaptive', 'uniform', 'global')),
+    Parameter('ghost_test', True, 'drop still blobs whose outline is an edge of the background '
+              'rather than of the frame (ghosts of what has left); they heal the window'),
+    Parameter('pixel_k', 6.0, 'multiple of the noise level that makes a pixel foreground '
+              '(adaptive, uniform)', 0.1, 100.0),
+    Parameter('median_size', 5, 'median filter of the adaptive decision at the processing '
+              'size (odd; 1 = off)', 1, 15, 2),
     Parameter('mask_threshold', 0.0, 'fixed threshold on |S| for data in [0, 1]; 0 = auto '
               '(max(mask_min_threshold, mask_k * robust sigma of D - L))', 0.0, 1.0),
     Parameter('mask_k', 5.0, 'multiple of the robust noise level of the auto threshold',
@@ -211,7 +227,12 @@ def detector_settings(values):
             'mask_rule': build_mask_rule(values),
             'motion_threshold': values['motion_threshold'],
             'min_frames': values['min_frames'], 'basis_rank': values['basis_rank'],
-            'global_change_fraction': values['global_change_fraction']}
+            'global_change_fraction': values['global_change_fraction'],
+            'memory_spacing': values['memory_spacing'],
+            'conditional_update': values['conditional_update'],
+            'absorb_frames': values['absorb_frames'], 'decision': values['decision'],
+            'pixel_k': values['pixel_k'], 'median_size': values['median_size'],
+            'ghost_test': values['ghost_test']}
 
 
 def validate(values):

@@ -139,7 +139,8 @@ class _FailingOnce:
 
 
 def test_solver_failure_keeps_the_previous_model_and_restarts_cold(scene):
-    detector = SlidingWindowDetector(window=20, stride=5)
+    # Grey: one fit per solve, so the model's second fit is the second solve.
+    detector = SlidingWindowDetector(window=20, stride=5, color='gray')
     failures = []
     for index, frame in enumerate(scene.frames[:40]):
         if index == 0:

@@ -14,7 +14,10 @@ Modules, one job each:
 - :mod:`.settings`: parameter checks and all-or-nothing reconfiguration.
 - :mod:`.buffer`: the buffered frames of a window, their rescaling, and the
   scene-change rule that restarts the window.
-- :mod:`.fast_path`: a frame's foreground from the last solve (l1 projection by IRLS).
+- :mod:`.background_memory`: the window's columns, admitted every few frames
+  with their foreground replaced by the background (conditional update).
+- :mod:`.fast_path`: a frame's background from the last solve (l1 projection by IRLS).
+- :mod:`.foreground`: the decision: each pixel against its own noise level, the ghost test.
 - :mod:`.window_solve`: one window solve, snapshot in, background model out.
 - :mod:`.sliding_window`: :class:`SlidingWindowDetector`, which puts them together.
 

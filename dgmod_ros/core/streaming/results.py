@@ -81,6 +81,9 @@ class WindowSnapshot:
     mask_rule: object           # likewise the MaskRule
     basis_rank: int             # likewise the fast path's basis size
     ticket: SolveTicket = None
+    observed: np.ndarray = None  # (n, m) bool: entries holding the frame's own pixel; None: all
+    first_column: int = None    # admission count of the oldest column (warm-start shift)
+    decision: str = 'global'    # likewise the decision rule ('adaptive' needs pixel noise)
 
 
 @dataclass
@@ -108,6 +111,10 @@ class BackgroundModel:
         Cost and outcome of the solve.
     ticket : SolveTicket or None
         The snapshot's ticket: who may install this model.
+    noise : ndarray (n,) or None
+        Each pixel's noise level (the adaptive decision), None for the global rule.
+    first_column : int or None
+        Admission count of the window's oldest column.
 
     """
 
@@ -123,3 +130,5 @@ class BackgroundModel:
     iterations: int = 0
     info: int = 0
     ticket: SolveTicket = None
+    noise: np.ndarray = None
+    first_column: int = None

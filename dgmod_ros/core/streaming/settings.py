@@ -37,6 +37,20 @@ def check_window_parameters(detector):
     rank = detector.basis_rank
     if int(rank) != rank or rank < 1:
         raise ValueError(f'basis_rank must be a positive integer, got {rank!r}')
+    spacing = detector.memory_spacing
+    if int(spacing) != spacing or spacing < 1:
+        raise ValueError(f'memory_spacing must be a positive integer, got {spacing!r}')
+    absorb = detector.absorb_frames
+    if int(absorb) != absorb or absorb < 1:
+        raise ValueError(f'absorb_frames must be a positive integer, got {absorb!r}')
+    if detector.decision not in ('adaptive', 'uniform', 'global'):
+        raise ValueError(f"decision must be 'adaptive', 'uniform' or 'global', "
+                         f'got {detector.decision!r}')
+    if not (np.isfinite(detector.pixel_k) and detector.pixel_k > 0):
+        raise ValueError(f'pixel_k must be positive, got {detector.pixel_k!r}')
+    size = detector.median_size
+    if int(size) != size or size < 1 or size % 2 == 0:
+        raise ValueError(f'median_size must be an odd positive integer, got {size!r}')
     (detector.mask_rule or MaskRule()).validate()
 
 

@@ -7,12 +7,16 @@ The node and the command line's ``stream`` mode both run this class, so the
 masks of a bag replayed through the node equal the offline command's.
 """
 
+from collections import deque
+
 import cv2
 import numpy as np
 
-from .buffer import FrameWindow, SceneChangeWatch
+from .background_memory import BackgroundMemory, conditional_columns
+from .buffer import SceneChangeWatch
 from .contract import StreamingDetector
-from .fast_path import foreground_magnitude
+from .fast_path import robust_projection
+from .foreground import adaptive_mask, ghost_blobs, to_input_size, warmup_noise
 from .results import FrameResult, WindowSnapshot
 from .settings import assign_validated, check_window_parameters
 from .window_solve import solve_window
@@ -20,17 +24,26 @@ from ..dgmod import DualGraphMOD
 from ..masks import MaskRule
 from ..preprocess import frame_columns, processing_shape
 
+# Frames back to the frame that tells whether a blob is still (the ghost test).
+_GHOST_LAG = 5
+# Growth of the foreground before the conditional update (processing pixels).
+_BORDER_KERNEL = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (5, 5))
+
 
 class SlidingWindowDetector(StreamingDetector):
     """
     Sliding-window separation with a fast path for every frame.
 
-    A frame's mask never waits for a solve: :meth:`push` masks it from the
+    A frame's mask never waits for a solve: :meth:`push` projects it onto the
     background subspace of the last window solve
-    (:mod:`~dgmod_ros.core.streaming.fast_path`) with the
-    :class:`~dgmod_ros.core.masks.MaskRule`. Every ``stride`` buffered frames
-    a solve of the whole window (any model with the ``fit(data, frame_shape,
-    init)`` interface) refreshes that subspace; see
+    (:mod:`~dgmod_ros.core.streaming.fast_path`) and decides each pixel
+    against its own noise level
+    (:mod:`~dgmod_ros.core.streaming.foreground`; ``decision='global'``: the
+    :class:`~dgmod_ros.core.masks.MaskRule`). The frame then enters the window
+    if due (:mod:`~dgmod_ros.core.streaming.background_memory`: every
+    ``memory_spacing`` frames, its foreground replaced by the background).
+    Every ``stride`` frames a solve of the whole window (any model with the
+    ``fit(data, frame_shape, init)`` interface) refreshes that subspace; see
     :class:`~dgmod_ros.core.streaming.contract.StreamingDetector` for the
     protocol that lets it run in another thread.
 
@@ -44,12 +57,12 @@ class SlidingWindowDetector(StreamingDetector):
         one, so sweeps add up over overlapping windows (``docs/solver.md``
         has the measured effect of the sweep count).
     window : int, default=30
-        Frames ``m`` kept in the window.
+        Columns ``m`` kept in the window.
     stride : int, default=10
-        Buffered frames between solves.
+        Frames between solves.
     scale : float, default=0.5
         Processing scale in (0, 1]; masks come back at the input size.
-    color : {'gray', 'rgb'}, default='gray'
+    color : {'gray', 'rgb'}, default='rgb'
         'rgb' solves each channel and fuses the magnitudes by their maximum.
     mask_rule : MaskRule or None
         None: ``MaskRule()``.
@@ -73,6 +86,33 @@ class SlidingWindowDetector(StreamingDetector):
         global gain change needs no restart (the projection absorbs it). 1.0
         disables the rule; a person filling more of the view than this
         fraction would also restart the window.
+    memory_spacing : int, default=10
+        Frames between admissions to the full window, so that it spans
+        ``window * memory_spacing`` frames; 1 is the window of consecutive
+        frames.
+    conditional_update : bool, default=True
+        Admit a frame with its foreground (the mask, dilated by 5 x 5 at the
+        processing size) replaced by the background, so that a person who
+        stops is not learned into the background.
+    absorb_frames : int, default=300
+        Foreground older than this many frames is admitted as it is (a left
+        object joins the background after about ``absorb_frames + window *
+        memory_spacing / 2`` frames).
+    decision : {'adaptive', 'uniform', 'global'}, default='adaptive'
+        'adaptive': each pixel against ``pixel_k`` times its own noise level;
+        'uniform': the same with the frame's typical noise level for all
+        pixels; 'global': the ``mask_rule`` (one threshold, morphology).
+    pixel_k : float, default=6.0
+        Multiple of the noise level that makes a pixel foreground ('adaptive',
+        'uniform').
+    median_size : int, default=5
+        Median filter of the adaptive decision at the processing size (odd;
+        1 disables it).
+    ghost_test : bool, default=True
+        Drop still blobs whose outline is an edge of the background rather
+        than of the frame (something in the window's frames has left; see
+        :func:`~dgmod_ros.core.streaming.foreground.ghost_blobs`); their
+        pixels enter the window as they are, which heals the background.
 
     Attributes
     ----------
@@ -88,9 +128,11 @@ class SlidingWindowDetector(StreamingDetector):
 
     """
 
-    def __init__(self, model=None, window=30, stride=10, scale=0.5, color='gray',
+    def __init__(self, model=None, window=30, stride=10, scale=0.5, color='rgb',
                  mask_rule=None, motion_threshold=0.0, min_frames=5, basis_rank=2,
-                 global_change_fraction=0.7):
+                 global_change_fraction=0.7, memory_spacing=10, conditional_update=True,
+                 absorb_frames=300, decision='adaptive', pixel_k=6.0, median_size=5,
+                 ghost_test=True):
         self.model = model
         self.window = window
         self.stride = stride
@@ -101,6 +143,13 @@ class SlidingWindowDetector(StreamingDetector):
         self.min_frames = min_frames
         self.basis_rank = basis_rank
         self.global_change_fraction = global_change_fraction
+        self.memory_spacing = memory_spacing
+        self.conditional_update = conditional_update
+        self.absorb_frames = absorb_frames
+        self.decision = decision
+        self.pixel_k = pixel_k
+        self.median_size = median_size
+        self.ghost_test = ghost_test
         self._validated = False
 
     # ------------------------------------------------------------- set-up
@@ -149,6 +198,7 @@ class SlidingWindowDetector(StreamingDetector):
             self.reset()
             return self
         self.buffer_.resize(int(self.window))
+        self.buffer_.spacing = int(self.memory_spacing)
         if ('scale' in params and params['scale'] != old['scale']
                 and self.input_shape_ is not None):
             rows, cols = processing_shape(self.input_shape_, self.scale)
@@ -157,12 +207,16 @@ class SlidingWindowDetector(StreamingDetector):
             self.shape_ = shape
             self.background_model_ = None
             self.background_pending_ = False
+            self.recent_.clear()            # frames of the old size
+            self.foreground_age_ = None
         return self
 
     def reset(self):
         """Forget every buffered frame and the background model."""
         self._new_generation()
-        self.buffer_ = FrameWindow(int(self.window))
+        self.buffer_ = BackgroundMemory(int(self.window), int(self.memory_spacing))
+        self.foreground_age_ = None
+        self.recent_ = deque(maxlen=_GHOST_LAG)
         self.scene_watch_ = SceneChangeWatch()
         self.background_model_ = None
         self.background_pending_ = False
@@ -185,19 +239,47 @@ class SlidingWindowDetector(StreamingDetector):
         self.input_shape_ = input_shape
         frame_id = self.next_id_
         self.next_id_ += 1
-        buffered = not self.buffer_.is_motionless(columns, self.motion_threshold)
-        if buffered:
-            self.buffer_.append(columns, frame_id)
-            self.since_solve_ += 1
-        return FrameResult(mask=None, magnitude=None, frame_id=frame_id, buffered=buffered,
+        self.since_solve_ += 1
+        return FrameResult(mask=None, magnitude=None, frame_id=frame_id, buffered=False,
                            reset=reset, model_ready=False), columns
+
+    def _background(self, columns):
+        """Return the frame's background (C, n) and its noise level (n,) or mask threshold."""
+        model = self.background_model_
+        if model is None:
+            # Warm-up: the per-pixel median of what is buffered is the background.
+            buffered = self.buffer_.stack(columns)
+            background = np.median(buffered, axis=2)
+            if self.decision == 'global':
+                residual = columns - background
+                return background, self.mask_rule_.estimate_threshold(residual, buffered)
+            return background, warmup_noise(buffered)
+        background = robust_projection(model.basis, columns)
+        if self.decision == 'global':
+            return background, model.threshold
+        if model.noise is None:             # solved under the global rule
+            return background, model.threshold / self.mask_rule_.k
+        return background, model.noise
 
     def _finish(self, pending):
         result, columns = pending
-        result.magnitude, threshold = foreground_magnitude(
-            columns, self.shape_, self.background_model_, self.buffer_.stack(columns),
-            self.mask_rule_)
-        result.mask = self.mask_rule_.apply(result.magnitude, threshold, self.input_shape_)
+        rows, cols, _ = self.shape_
+        background, level = self._background(columns)
+        if self.decision == 'global':
+            result.magnitude = np.abs(columns - background).max(axis=0).reshape(rows, cols)
+            result.mask = self.mask_rule_.apply(result.magnitude, level, self.input_shape_)
+            foreground = np.where(result.magnitude > level, np.uint8(255), np.uint8(0))
+        else:
+            foreground, result.magnitude = adaptive_mask(
+                columns, background, level, self.pixel_k, self.shape_, self.median_size)
+            if (self.ghost_test and self.background_model_ is not None
+                    and len(self.recent_) == self.recent_.maxlen):
+                ghosts = ghost_blobs(foreground, columns, background, self.recent_[0][1],
+                                     level, self.pixel_k)
+                foreground[ghosts] = 0
+            result.mask = to_input_size(foreground, self.input_shape_)
+        result.buffered = self._admit(columns, background, foreground, result.frame_id)
+        self.recent_.append((result.frame_id, columns))
         result.model_ready = self.background_model_ is not None
         result.new_background = self.background_pending_
         self.background_pending_ = False
@@ -206,10 +288,37 @@ class SlidingWindowDetector(StreamingDetector):
             self._restart_from_newest(SceneChangeWatch.FRAMES)
         return result
 
+    def _admit(self, columns, background, foreground, frame_id):
+        """Put the frame into the window if due (conditionally); return whether it went in."""
+        is_foreground = foreground.ravel() > 0
+        age = self.foreground_age_
+        if age is None or age.shape != is_foreground.shape:
+            age = np.zeros(is_foreground.shape, dtype=np.int32)
+        self.foreground_age_ = np.where(is_foreground, age + 1, 0).astype(np.int32)
+        if (not self.buffer_.wants(frame_id)
+                or self.buffer_.is_motionless(columns, self.motion_threshold)):
+            return False
+        observed = None
+        # While the window fills, every frame goes in as it is: the first
+        # solves must separate whatever moves in the first frames, and a
+        # model learnt from a few frames is no ground for holding pixels back.
+        if (self.conditional_update and self.background_model_ is not None
+                and len(self.buffer_) >= self.buffer_.capacity):
+            # Dilated: a silhouette's border is foreground below the threshold.
+            grown = cv2.dilate(foreground, _BORDER_KERNEL).ravel() > 0
+            columns, observed = conditional_columns(columns, background, grown,
+                                                    self.foreground_age_, self.absorb_frames)
+        self.buffer_.append(columns, frame_id, observed)
+        return True
+
     def _restart_from_newest(self, count):
-        """Keep only the newest ``count`` frames and drop the model (a scene change)."""
+        """Restart the window from the newest ``count`` frames, drop the model (scene change)."""
         self._new_generation()
-        self.since_solve_ = self.buffer_.keep_newest(count)
+        self.buffer_.clear()
+        for frame_id, columns in list(self.recent_)[-count:]:
+            self.buffer_.append(columns, frame_id)
+        self.since_solve_ = len(self.buffer_)
+        self.foreground_age_ = None
         self.background_model_ = None
         self.background_pending_ = False
         self.scene_changes_ += 1
@@ -248,7 +357,9 @@ class SlidingWindowDetector(StreamingDetector):
         return WindowSnapshot(data=data, shape=self.shape_, first_id=self.buffer_.first_id,
                               last_id=self.buffer_.last_id, previous=self.background_model_,
                               model=self.model_, mask_rule=self.mask_rule_,
-                              basis_rank=int(self.basis_rank), ticket=self._ticket())
+                              basis_rank=int(self.basis_rank), ticket=self._ticket(),
+                              observed=self.buffer_.observed(),
+                              first_column=self.buffer_.first_column, decision=self.decision)
 
     def solve(self, snapshot):
         """

@@ -7,6 +7,7 @@ import time
 import numpy as np
 
 from .fast_path import background_basis
+from .foreground import pixel_noise
 from .results import BackgroundModel, SolverFailure
 from ..separation import separate_channels
 
@@ -23,7 +24,10 @@ def warm_starts(snapshot):
     if (previous is None or previous.shape != snapshot.shape or not previous.states
             or any(s is None for s in previous.states)):
         return [None] * channels
-    shift = snapshot.first_id - previous.first_id
+    if snapshot.first_column is not None and previous.first_column is not None:
+        shift = snapshot.first_column - previous.first_column
+    else:
+        shift = snapshot.first_id - previous.first_id
     width = snapshot.data.shape[2]
     if not 0 <= shift < width or previous.states[0].frames != width:
         return [None] * channels
@@ -50,6 +54,10 @@ def solve_window(snapshot):
     backgrounds = separated.backgrounds
     if separated.diverged or not all(np.all(np.isfinite(b)) for b in backgrounds):
         raise SolverFailure('window solve produced non-finite values')
+    noise = None
+    if snapshot.decision != 'global':
+        noise = pixel_noise(separated.residuals, snapshot.shape, snapshot.observed,
+                            uniform=snapshot.decision == 'uniform')
     bases = [background_basis(b, int(snapshot.basis_rank)) for b in backgrounds]
     basis = np.zeros((channels, rows * cols, max(b.shape[1] for b in bases)), dtype=np.float32)
     for channel, channel_basis in enumerate(bases):
@@ -63,4 +71,5 @@ def solve_window(snapshot):
         threshold=separated.threshold(snapshot.mask_rule, snapshot.data),
         shape=snapshot.shape, first_id=snapshot.first_id, last_id=snapshot.last_id,
         states=separated.states, seconds=time.perf_counter() - started,
-        iterations=separated.iterations, info=separated.info, ticket=snapshot.ticket)
+        iterations=separated.iterations, info=separated.info, ticket=snapshot.ticket,
+        noise=noise, first_column=snapshot.first_column)

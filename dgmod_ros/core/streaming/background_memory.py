@@ -1,0 +1,123 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""
+The window the model solves: frames spread over a long span, foreground left out.
+
+A window of ``m`` consecutive frames forgets in ``m`` frames: a person who
+stands still for half a window is learned into the background ``L`` and
+vanishes from the masks. :class:`BackgroundMemory` keeps the same ``m``
+columns but admits a frame only every ``spacing`` frames once it is full, so
+the window spans ``m * spacing`` frames, and it admits a frame
+conditionally: where the frame's own mask says foreground, the column holds
+the current background instead of the frame (the pixel counts as not
+observed). A person who stops therefore stays foreground, while everything
+the masks call background keeps refreshing the model. A pixel that has been
+foreground for ``absorb_frames`` frames in a row is admitted as it is, so an
+object that stays (or a mistake of the masks) joins the background after
+about ``absorb_frames + m * spacing / 2`` frames, when the l1 fit lets the
+majority of the window win.
+"""
+
+from collections import deque
+
+import numpy as np
+
+from .buffer import FrameWindow
+
+
+class BackgroundMemory(FrameWindow):
+    """
+    The window's columns, admitted every ``spacing`` frames, with their observed pixels.
+
+    Parameters
+    ----------
+    capacity : int
+        Columns kept (the window ``m``).
+    spacing : int
+        Frames between admissions once the window is full (1: every frame,
+        the plain sliding window). While filling, every frame is admitted so
+        that the first solves have frames to work on.
+
+    """
+
+    def __init__(self, capacity, spacing=1):
+        super().__init__(capacity)
+        self.spacing = int(spacing)
+        self._observed = deque(maxlen=int(capacity))
+        self.admitted = 0               # columns admitted so far (warm-start bookkeeping)
+        self.last_admitted_id = None
+
+    @property
+    def first_column(self):
+        """Return the admission count of the oldest column (warm-start shifts)."""
+        return self.admitted - len(self)
+
+    def wants(self, frame_id):
+        """Tell whether the frame ``frame_id`` is due for admission."""
+        if len(self) < self.capacity or self.last_admitted_id is None:
+            return True
+        return frame_id - self.last_admitted_id >= self.spacing
+
+    def append(self, columns, frame_id, observed=None):
+        """Admit a frame's columns (C, n); ``observed`` (n,) bool marks the frame's own pixels."""
+        super().append(columns, frame_id)
+        self._observed.append(observed)
+        self.admitted += 1
+        self.last_admitted_id = frame_id
+
+    def observed(self):
+        """Return the observed pixels of the columns (n, m) bool, or None when all are."""
+        if all(o is None for o in self._observed):
+            return None
+        n = self._frames[0].shape[1]
+        full = np.ones(n, dtype=bool)
+        return np.stack([full if o is None else o for o in self._observed], axis=1)
+
+    def clear(self):
+        """Forget every column (the admission count goes on)."""
+        for store in (self._ids, self._frames, self._observed):
+            store.clear()
+        self.last_admitted_id = None
+
+    def keep_newest(self, count):
+        """Drop all but the newest ``count`` columns; return how many remain."""
+        recent = list(zip(self._ids, self._frames, self._observed))[-count:]
+        for store in (self._ids, self._frames, self._observed):
+            store.clear()
+        for frame_id, columns, observed in recent:
+            self._ids.append(frame_id)
+            self._frames.append(columns)
+            self._observed.append(observed)
+        return len(recent)
+
+    def resize(self, capacity):
+        """Keep at most ``capacity`` columns from now on, the newest first."""
+        super().resize(capacity)
+        self._observed = deque(self._observed, maxlen=int(capacity))
+
+    def rescale(self, old_shape, new_shape):
+        """Resample every column to ``new_shape``; every pixel counts as observed again."""
+        super().rescale(old_shape, new_shape)
+        self._observed = deque([None] * len(self), maxlen=self.capacity)
+
+
+def conditional_columns(columns, background, foreground, foreground_age, absorb_frames):
+    """
+    Return the columns to admit and their observed pixels (conditional update).
+
+    Parameters
+    ----------
+    columns, background : ndarray (C, n)
+        The frame and its background at the processing size.
+    foreground : ndarray (n,) bool
+        The frame's foreground at the processing size (already dilated by the caller).
+    foreground_age : ndarray (n,) int
+        Consecutive frames each pixel has been foreground.
+    absorb_frames : int
+        Foreground older than this is admitted as it is.
+
+    """
+    replaced = foreground & (foreground_age < absorb_frames)
+    if not replaced.any():
+        return columns, None
+    return np.where(replaced[None, :], background, columns), ~replaced

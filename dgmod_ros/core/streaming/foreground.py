@@ -1,0 +1,171 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""
+The foreground decision: each pixel against its own noise level.
+
+One threshold for the whole frame treats a flickering monitor and a flat
+wall alike. Here every pixel gets ``k`` times its own noise level ``sigma_p``,
+read from the last window solve: the median of ``|D - L|`` (largest over the
+colour channels) over the window's columns in which the pixel was observed
+(not filled in by the conditional update, see
+:mod:`~dgmod_ros.core.streaming.background_memory`), times 1.4826 (the
+standard deviation for Gaussian noise). The median ignores the columns in
+which the pixel was foreground, as long as they are fewer than half. No pixel
+is taken as quieter than the frame's typical pixel (the median of
+``sigma_p`` over the frame): only noisy places get a higher threshold, and a
+pixel seen fewer than :data:`MIN_OBSERVED` times gets the typical level. The
+levels are smoothed over a 5 x 5 neighbourhood, which shares the noise of a
+surface (leaves, a screen).
+
+A frame's distance to its background is the largest absolute difference
+over the channels (colour catches a person whose grey level matches the
+wall). The binary decision is cleaned by a median filter (a majority vote of
+the neighbourhood: fills pinholes, removes specks, keeps thin limbs better
+than an opening) and brought to the input size by bilinear interpolation of
+the 0/255 mask, thresholded at half.
+"""
+
+import cv2
+import numpy as np
+
+from ..masks import robust_sigma
+
+#: Observations a pixel needs for its own noise level.
+MIN_OBSERVED = 3
+# Gaussian consistency factor of the median absolute value.
+_MAD_TO_SIGMA = 1.4826
+# Side of the box filter that smooths the noise levels.
+_NOISE_SMOOTHING = 5
+# Smallest noise level: one grey level of 8-bit data.
+_QUANTUM = 1.0 / 255.0
+# A blob with fewer of its pixels changed over the last frames than this share is still.
+_GHOST_MOVING_SHARE = 0.1
+
+
+def pixel_noise(residual, shape, observed=None, uniform=False):
+    """
+    Return each pixel's noise level ``sigma_p`` (n,) float32 from a window's residual.
+
+    Parameters
+    ----------
+    residual : ndarray (C, n, m)
+        ``D - L`` of the window.
+    shape : tuple (rows, cols, C)
+        Processing shape.
+    observed : ndarray (n, m) bool or None
+        Entries that hold the frame's own pixel; None: all.
+    uniform : bool
+        Give every pixel the typical level (the ablation of the per-pixel rule).
+
+    """
+    rows, cols = shape[:2]
+    magnitude = np.abs(residual).max(axis=0)                     # (n, m)
+    if observed is None:
+        median = np.median(magnitude, axis=1)
+        count = np.full(magnitude.shape[0], magnitude.shape[1])
+    else:
+        # Median over each pixel's observed columns: unobserved entries sort last.
+        ordered = np.sort(np.where(observed, magnitude, np.inf), axis=1)
+        count = np.count_nonzero(observed, axis=1)
+        median = ordered[np.arange(ordered.shape[0]), np.maximum(count - 1, 0) // 2]
+    sigma = _MAD_TO_SIGMA * median
+    seen = count >= MIN_OBSERVED
+    typical = float(np.median(sigma[seen])) if np.any(seen) else robust_sigma(magnitude)
+    typical = max(typical, _QUANTUM)
+    if uniform:
+        return np.full(rows * cols, typical, dtype=np.float32)
+    sigma = np.where(seen, np.maximum(sigma, typical), typical).astype(np.float32)
+    smooth = cv2.blur(sigma.reshape(rows, cols), (_NOISE_SMOOTHING, _NOISE_SMOOTHING))
+    return smooth.ravel()
+
+
+def warmup_noise(buffered):
+    """Return one noise level for every pixel before the first solve, from frame differences."""
+    if buffered.shape[-1] < 2:
+        return _QUANTUM
+    differences = np.abs(np.diff(buffered, axis=-1)).max(axis=0)
+    return max(robust_sigma(differences) / np.sqrt(2.0), _QUANTUM)
+
+
+def adaptive_mask(columns, background, noise, k, shape, median_size):
+    """
+    Return a frame's foreground at the processing size (uint8 0/255) and its distance.
+
+    Parameters
+    ----------
+    columns, background : ndarray (C, n)
+        The frame and its background.
+    noise : ndarray (n,) or float
+        Each pixel's noise level.
+    k : float
+        Multiple of the noise level that makes a pixel foreground.
+    shape : tuple (rows, cols, C)
+        Processing shape.
+    median_size : int
+        Side of the median filter (odd); <= 1 disables it.
+
+    """
+    rows, cols = shape[:2]
+    distance = np.abs(columns - background).max(axis=0)
+    mask = np.where(distance > k * noise, np.uint8(255), np.uint8(0)).reshape(rows, cols)
+    if median_size > 1:
+        mask = cv2.medianBlur(mask, int(median_size))
+    return mask, distance.reshape(rows, cols)
+
+
+def to_input_size(mask, output_shape):
+    """Bring a 0/255 mask to ``output_shape`` by bilinear interpolation thresholded at half."""
+    if mask.shape == tuple(output_shape):
+        return mask
+    smooth = cv2.resize(mask, (output_shape[1], output_shape[0]),
+                        interpolation=cv2.INTER_LINEAR)
+    return np.where(smooth > 127, np.uint8(255), np.uint8(0))
+
+
+def _edge_strength(image):
+    return np.abs(cv2.Sobel(image, cv2.CV_32F, 1, 0)) + np.abs(cv2.Sobel(image, cv2.CV_32F, 0, 1))
+
+
+def ghost_blobs(mask, frame, background, earlier, noise, k):
+    """
+    Return the pixels (rows, cols) bool of foreground blobs that are ghosts.
+
+    A ghost is a blob where the background is wrong (something that was in
+    the window's frames has left), not where something is in front of it.
+    Two tests, both required: the blob is still (its pixels match the frame
+    ``earlier`` within ``k`` noise levels: a walking person fails this), and
+    its outline is an edge of the background rather than of the frame (the
+    summed gradient magnitude along the blob's border is larger in the
+    background image: the edges belong to what has left).
+
+    Parameters
+    ----------
+    mask : ndarray (rows, cols) uint8
+        The frame's foreground at the processing size.
+    frame, background, earlier : ndarray (C, n)
+        The frame, its background and a frame a few frames before.
+    noise : ndarray (n,) or float
+        Each pixel's noise level.
+    k : float
+        Multiple of the noise level that counts as a change.
+
+    """
+    rows, cols = mask.shape
+    count, labels = cv2.connectedComponents(mask, connectivity=8)
+    if count <= 1:
+        return np.zeros(mask.shape, dtype=bool)
+    flat = labels.ravel()
+    moved = np.abs(frame - earlier).max(axis=0) > k * noise
+    moving_share = (np.bincount(flat, moved, minlength=count)
+                    / np.maximum(np.bincount(flat, minlength=count), 1))
+    border = cv2.morphologyEx(mask, cv2.MORPH_GRADIENT, np.ones((3, 3), np.uint8)) > 0
+    # Border pixels just outside a blob take the blob's label from a 3 x 3 dilation.
+    owner = cv2.dilate(labels.astype(np.float32), np.ones((3, 3), np.uint8))
+    owner = owner.astype(np.int32)[border]
+    frame_edges = _edge_strength(frame.mean(axis=0).reshape(rows, cols))[border]
+    background_edges = _edge_strength(background.mean(axis=0).reshape(rows, cols))[border]
+    in_frame = np.bincount(owner, frame_edges, minlength=count)
+    in_background = np.bincount(owner, background_edges, minlength=count)
+    ghost = (moving_share < _GHOST_MOVING_SHARE) & (in_background > in_frame)
+    ghost[0] = False
+    return ghost[labels]
