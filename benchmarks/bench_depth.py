@@ -12,7 +12,6 @@ benchmarks/bench_node.py.
 Usage (repo root): PYTHONPATH=. python benchmarks/bench_depth.py
 """
 
-import time
 from types import SimpleNamespace
 
 from dgmod_ros.core.depth import (back_project, depth_in_metres, invalidate_background,
@@ -21,17 +20,9 @@ from dgmod_ros.core.synthetic import synthetic_rgbd_scene
 from dgmod_ros.image_conversion import array_to_image_fields, depth_image_to_array
 from dgmod_ros.point_cloud import point_cloud_fields
 import numpy as np
+from timing import median_ms
 
 REPEATS = 200
-
-
-def _median_ms(work):
-    times = []
-    for _ in range(REPEATS):
-        start = time.perf_counter()
-        work()
-        times.append(time.perf_counter() - start)
-    return 1e3 * float(np.median(times))
 
 
 def main():
@@ -53,7 +44,7 @@ def main():
                 point_cloud_fields(points)
                 return points.shape[0]
             points = frame()
-            print(f'  {encoding} cloud_pixel_step {step}: {_median_ms(frame):6.2f} ms, '
+            print(f'  {encoding} cloud_pixel_step {step}: {median_ms(frame, REPEATS):6.2f} ms, '
                   f'{points} points')
 
 

@@ -14,7 +14,6 @@ Usage::
 """
 
 import argparse
-import time
 
 import cv2
 from dgmod_ros import config
@@ -25,16 +24,7 @@ from dgmod_ros.core.streaming.foreground import (adaptive_mask, ghost_blobs, pix
                                                  to_input_size)
 from dgmod_ros.core.synthetic import synthetic_scene
 import numpy as np
-
-
-def median_ms(function, repeats):
-    """Return the median wall time of ``function()`` in milliseconds."""
-    times = []
-    for _ in range(repeats):
-        started = time.perf_counter()
-        function()
-        times.append(time.perf_counter() - started)
-    return 1000.0 * float(np.median(times))
+from timing import median_ms
 
 
 def main():
