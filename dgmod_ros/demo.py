@@ -22,6 +22,7 @@ import numpy as np
 
 from .core.masks import overlay
 from .core.metrics import ConfusionCounts, iou, psnr
+from .core.preprocess import to_float_channels
 from .core.runtime import keep_freed_memory
 from .core.synthetic import synthetic_scene
 from .image_conversion import fill_image, image_to_array
@@ -125,6 +126,8 @@ def run(source=None, out_dir='out/demo'):
         if mask is not None:
             cv2.imwrite(str(out / 'masks' / f'{stem}.png'), mask)
     for stamp, background in backgrounds:
+        if background.ndim == 3:
+            background = cv2.cvtColor(background, cv2.COLOR_RGB2BGR)     # imwrite takes BGR
         cv2.imwrite(str(out / 'background' / f'{stems[stamp // 10**9]}.png'), background)
     picks = np.linspace(len(frames) // 5, len(frames) - 1, 5).astype(int)
     montage = [overlay(frames[i] / 255.0, masks[i]) for i in picks if masks[i] is not None]
@@ -137,9 +140,10 @@ def run(source=None, out_dir='out/demo'):
         warm = 30
         figures['mean_iou'] = float(np.mean([iou(m, t) for m, t in
                                              zip(masks[warm:], truth[warm:]) if m is not None]))
+        # The truth is grey; a colour background (color: rgb) is compared by its luma.
         figures['background_psnr_db'] = float(np.median([
-            psnr(b.astype(np.float32) / 255.0, true_backgrounds[s // 10**9])
-            for s, b in backgrounds if b.ndim == 2]))
+            psnr(to_float_channels(b, 'rgb', 'gray')[:, :, 0], true_backgrounds[s // 10**9])
+            for s, b in backgrounds]))
     elif truth is not None:                                     # CDnet-style ground truth
         counts = ConfusionCounts()
         for mask, gt in zip(masks, truth):
