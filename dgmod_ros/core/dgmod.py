@@ -376,11 +376,12 @@ class DualGraphMOD:
 
     def _run_fused(self, data, ops, iterates, history, data_norm):
         """
-        Sweep with the two compiled passes of :mod:`dgmod_ros.core.kernels`.
+        Sweep with the compiled passes of :mod:`dgmod_ros.core.kernels`.
 
-        The same steps as :meth:`_run_numpy` in the same order; between the
-        passes BLAS forms the Gram matrix of ``Lh = L - Y1`` and the SVT as
-        the rank-k product ``U = (Lh left) right_t``.
+        The same steps as :meth:`_run_numpy` in the same order, the same
+        iterates and the same stopping sweep; after the primal pass BLAS forms
+        the Gram matrix of ``Lh = L - Y1`` and the SVT as the rank-k product
+        ``U = (Lh left) right_t``; the dual updates ride on the next primal pass.
         """
         from . import kernels       # numba compiles or loads its cache on first use
         # Again at every solve: an OpenBLAS loaded since (scipy.linalg's) must
@@ -404,7 +405,25 @@ class DualGraphMOD:
         L_new, S_new, V_new, Lh = (np.empty_like(data) for _ in range(4))
         rhs = work = None
         threshold = self.lambda1_ / rho1
+        # The dual updates of a sweep run at the start of the next primal pass
+        # (one pass a sweep); its stopping figures are known only then, so a
+        # sweep that meets the rule costs one primal pass whose results are
+        # dropped. The numpy L-steps need the updated duals first: no merge.
+        merge = not l_given
+        pending = None      # (change_L, change_S, rank) of a sweep whose dual update waits
+
+        def finish(squared_residuals):
+            residual_U, residual_V = np.sqrt(squared_residuals) / data_norm
+            return self._record(history, pending[0], pending[1], float(residual_U),
+                                float(residual_V), pending[2])
+
         for _ in range(self.max_iter):
+            if pending is not None and not merge:
+                stop = finish(kernels.dual_pass(data, L, S, V, U, Y1, Y2))
+                pending = None
+                if stop:
+                    self.info_ = 0
+                    break
             if l_given:
                 if rhs is None:
                     rhs, work = np.empty_like(data), np.empty_like(data)
@@ -412,10 +431,16 @@ class DualGraphMOD:
                 np.copyto(L_new, self._l_step(rhs, L, ops, c))
             sums = kernels.primal_pass(
                 data, L, U, Y1, S, V, Y2, s_offsets, s_bands, t_offsets, t_bands,
-                coefficients, l_given, L_new, S_new, V_new, Lh)
+                coefficients, l_given, pending is not None, L_new, S_new, V_new, Lh)
+            if pending is not None:
+                stop = finish(sums[4:])
+                pending = None
+                if stop:
+                    self.info_ = 0
+                    break
             gram = Lh.T @ Lh
-            if not (np.isfinite(gram).all() and np.isfinite(sums).all()):
-                self.info_ = -1     # L_new, S_new, V_new are dropped; Y1, Y2 untouched
+            if not (np.isfinite(gram).all() and np.isfinite(sums[:4]).all()):
+                self.info_ = -1     # L_new, S_new, V_new are dropped
                 break
             if threshold == 0:      # no nuclear norm (FRPCAG): the prox is the identity
                 left = right_t = np.eye(data.shape[1], dtype=np.float32)
@@ -424,18 +449,13 @@ class DualGraphMOD:
                 left, right_t, sigma, rank = mixing_factors(gram, lambda values: np.maximum(
                     values - weights[:values.size] * threshold, 0.0))
             weights = np.exp(-(sigma / self.weight_scale_) ** 2).astype(np.float32)
-            change_L = _ratio(sums[0], sums[1])
-            change_S = _ratio(sums[2], sums[3])
             L, L_new = L_new, L
             S, S_new = S_new, S
             V, V_new = V_new, V
             np.matmul(Lh @ left.astype(np.float32), right_t.astype(np.float32), out=U)
-            residual_U, residual_V = np.sqrt(
-                kernels.dual_pass(data, L, S, V, U, Y1, Y2)) / data_norm
-            if self._record(history, change_L, change_S, float(residual_U),
-                            float(residual_V), rank):
-                self.info_ = 0
-                break
+            pending = (_ratio(sums[0], sums[1]), _ratio(sums[2], sums[3]), rank)
+        if pending is not None and finish(kernels.dual_pass(data, L, S, V, U, Y1, Y2)):
+            self.info_ = 0          # the last sweep's dual update, after the loop
         iterates.update(L=L, S=S, U=U, V=V, Y1=Y1, Y2=Y2, weights=weights, sigma=sigma)
 
     # ------------------------------------------------------------------ public

@@ -4,16 +4,15 @@
 Fused, multi-threaded kernels of one ADMM sweep of :class:`DualGraphMOD`.
 
 A sweep of the numpy formulation is about 25 single-threaded passes over
-``n x m`` float32 arrays. Here it is two passes, each threaded over blocks of
-pixel rows:
+``n x m`` float32 arrays. Here it is one pass, threaded over blocks of pixel
+rows (:func:`primal_pass`): the previous sweep's dual updates and the sums of
+squares of its primal residuals, the gradient L-step (spatial and temporal
+Laplacians applied as diagonal bands), the S- and V-shrinkages, ``Lh = L - Y1``
+and the sums of squares behind the relative changes. :func:`dual_pass` does
+the dual updates alone, for the last sweep and for the L-steps computed in
+numpy (which need the updated duals first).
 
-- :func:`primal_pass`: the gradient L-step (spatial and temporal Laplacians
-  applied as diagonal bands), the S- and V-shrinkages, ``Lh = L - Y1`` and
-  the sums of squares behind the relative changes;
-- :func:`dual_pass`: the dual updates and the sums of squares of the primal
-  residuals.
-
-Between them the weighted SVT stays with BLAS: the Gram matrix ``Lh^T Lh``
+Between passes the weighted SVT stays with BLAS: the Gram matrix ``Lh^T Lh``
 and the rank-k product ``U = (Lh left) right_t`` are dense products that a
 hand-written loop does several times slower than sgemm.
 
@@ -97,7 +96,7 @@ _FAST = {'reassoc', 'contract', 'nsz'}
 
 @njit(parallel=True, cache=True, fastmath=_FAST, nogil=True)
 def primal_pass(data, L, U, Y1, S, V, Y2,
-                s_offsets, s_bands, t_offsets, t_bands, coefficients, l_given,
+                s_offsets, s_bands, t_offsets, t_bands, coefficients, l_given, dual_first,
                 L_new, S_new, V_new, Lh):
     """
     Run steps 1, 2 and 4 of a sweep and form the SVT input, fused, threaded over row blocks.
@@ -106,8 +105,11 @@ def primal_pass(data, L, U, Y1, S, V, Y2,
     ``V_new`` and ``Lh = L_new - Y1``. ``coefficients`` = (g1, g2, c, rho1,
     rho2, step, lam2 / rho2, 1 / rho2) as float64. With ``l_given`` the L-step
     is skipped and ``L_new`` is read as the caller computed it (the exact or
-    multi-step L-steps). Returns the float64 sums
-    ``(||L_new - L||^2, ||L||^2, ||S_new - S||^2, ||S||^2)``.
+    multi-step L-steps). With ``dual_first`` each row first takes the previous
+    sweep's dual updates (what :func:`dual_pass` does, with ``U`` that sweep's
+    SVT): one pass over the arrays instead of two. Returns the float64 sums
+    ``(||L_new - L||^2, ||L||^2, ||S_new - S||^2, ||S||^2, ||U - L||^2,
+    ||D - L - S - V||^2)``, the last two zero without ``dual_first``.
     """
     n, m = data.shape
     g1 = np.float32(coefficients[0])
@@ -119,7 +121,7 @@ def primal_pass(data, L, U, Y1, S, V, Y2,
     t_s = np.float32(coefficients[6])
     t_v = np.float32(coefficients[7])
     n_blocks = (n + _BLOCK_ROWS - 1) // _BLOCK_ROWS
-    sums = np.zeros((n_blocks, 4), dtype=np.float64)
+    sums = np.zeros((n_blocks, 6), dtype=np.float64)
     reach = 0
     for k in range(t_offsets.size):
         reach = max(reach, abs(t_offsets[k]))
@@ -134,7 +136,17 @@ def primal_pass(data, L, U, Y1, S, V, Y2,
         n_l = 0.0
         d_s = 0.0
         n_s = 0.0
+        r_u = 0.0
+        r_v = 0.0
         for i in range(b * _BLOCK_ROWS, min(n, (b + 1) * _BLOCK_ROWS)):
+            if dual_first:      # row-local: the L-step below reads Y1, Y2 of row i only
+                for j in range(m):
+                    gap = U[i, j] - L[i, j]
+                    Y1[i, j] += gap
+                    r_u += gap * gap
+                    residual = data[i, j] - L[i, j] - S[i, j] - V[i, j]
+                    Y2[i, j] += residual
+                    r_v += residual * residual
             if not l_given:
                 for j in range(m):
                     spatial[j] = 0.0
@@ -176,6 +188,8 @@ def primal_pass(data, L, U, Y1, S, V, Y2,
         sums[b, 1] = n_l
         sums[b, 2] = d_s
         sums[b, 3] = n_s
+        sums[b, 4] = r_u
+        sums[b, 5] = r_v
     return sums.sum(axis=0)
 
 
