@@ -87,6 +87,20 @@ def _shrink(x, t):
     return x - min(max(x, -t), t)
 
 
+@njit(cache=True, inline='always')
+def _dual_row(i, data, L, S, V, U, Y1, Y2, r_u, r_v):
+    # One row of Y1 += U - L, Y2 += D - L - S - V; the residuals' sums of
+    # squares go on from r_u, r_v (the callers' running block sums).
+    for j in range(data.shape[1]):
+        gap = U[i, j] - L[i, j]
+        Y1[i, j] += gap
+        r_u += gap * gap
+        residual = data[i, j] - L[i, j] - S[i, j] - V[i, j]
+        Y2[i, j] += residual
+        r_v += residual * residual
+    return r_u, r_v
+
+
 # Reassociation lets the compiler vectorise the sums of squares; no
 # 'nnan'/'ninf': the solver detects a non-finite iterate from those sums.
 # nogil: a pass takes milliseconds, and the node's image callback must not
@@ -140,13 +154,7 @@ def primal_pass(data, L, U, Y1, S, V, Y2,
         r_v = 0.0
         for i in range(b * _BLOCK_ROWS, min(n, (b + 1) * _BLOCK_ROWS)):
             if dual_first:      # row-local: the L-step below reads Y1, Y2 of row i only
-                for j in range(m):
-                    gap = U[i, j] - L[i, j]
-                    Y1[i, j] += gap
-                    r_u += gap * gap
-                    residual = data[i, j] - L[i, j] - S[i, j] - V[i, j]
-                    Y2[i, j] += residual
-                    r_v += residual * residual
+                r_u, r_v = _dual_row(i, data, L, S, V, U, Y1, Y2, r_u, r_v)
             if not l_given:
                 for j in range(m):
                     spatial[j] = 0.0
@@ -200,20 +208,14 @@ def dual_pass(data, L, S, V, U, Y1, Y2):
 
     Returns the float64 sums ``(||U - L||^2, ||D - L - S - V||^2)``.
     """
-    n, m = data.shape
+    n = data.shape[0]
     n_blocks = (n + _BLOCK_ROWS - 1) // _BLOCK_ROWS
     sums = np.zeros((n_blocks, 2), dtype=np.float64)
     for b in prange(n_blocks):
         r_u = 0.0
         r_v = 0.0
         for i in range(b * _BLOCK_ROWS, min(n, (b + 1) * _BLOCK_ROWS)):
-            for j in range(m):
-                gap = U[i, j] - L[i, j]
-                Y1[i, j] += gap
-                r_u += gap * gap
-                residual = data[i, j] - L[i, j] - S[i, j] - V[i, j]
-                Y2[i, j] += residual
-                r_v += residual * residual
+            r_u, r_v = _dual_row(i, data, L, S, V, U, Y1, Y2, r_u, r_v)
         sums[b, 0] = r_u
         sums[b, 1] = r_v
     return sums.sum(axis=0)
