@@ -25,7 +25,7 @@ from .core.metrics import ConfusionCounts, iou, psnr
 from .core.preprocess import to_float_channels
 from .core.runtime import keep_freed_memory
 from .core.synthetic import synthetic_scene
-from .image_conversion import fill_image, image_to_array
+from .image_conversion import fill_image, image_to_array, stamp_ns
 from .inputs import BadInput, read_frames
 
 
@@ -76,10 +76,10 @@ def replay(frames, rate=30.0, **parameters):
     masks, backgrounds = {}, []
 
     def on_mask(msg):
-        masks[msg.header.stamp.sec * 10**9 + msg.header.stamp.nanosec] = image_to_array(msg)[0]
+        masks[stamp_ns(msg.header)] = image_to_array(msg)[0]
 
     def on_background(msg):
-        stamp = msg.header.stamp.sec * 10**9 + msg.header.stamp.nanosec
+        stamp = stamp_ns(msg.header)
         backgrounds.append((stamp, image_to_array(msg)[0]))
 
     camera.create_subscription(Image, 'foreground_mask', on_mask, QoSProfile(depth=100))

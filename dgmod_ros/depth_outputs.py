@@ -27,17 +27,13 @@ from rclpy.qos_overriding_options import QoSOverridingOptions
 from sensor_msgs.msg import CameraInfo, Image, PointCloud2, PointField
 
 from .core.depth import back_project, depth_in_metres, invalidate_background, PinholeIntrinsics
-from .image_conversion import depth_image_to_array, fill_image, ImageConversionError
+from .image_conversion import (depth_image_to_array, fill_image, ImageConversionError,
+                               stamp_ns)
 from .point_cloud import point_cloud_fields
 from .stamp_pairing import StampPairer
 
 # Seconds between repeats of one kind of warning.
 _WARN_PERIOD = 5.0
-
-
-def stamp_ns(header):
-    """Return a header's stamp in nanoseconds."""
-    return header.stamp.sec * 1_000_000_000 + header.stamp.nanosec
 
 
 def cloud_message(points, header):

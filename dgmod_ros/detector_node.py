@@ -43,7 +43,7 @@ from .core.preprocess import to_float_channels, to_uint8
 from .core.streaming import SolverFailure
 from .depth_outputs import DepthOutputs
 from .image_conversion import (compressed_image_to_array, fill_image, image_to_array,
-                               ImageConversionError)
+                               ImageConversionError, stamp_ns)
 from .solve_worker import SolveWorker
 from .stats import DetectorStats
 from .transport import LargeImageCheck
@@ -214,7 +214,7 @@ class DetectorNode(LifecycleNode):
             self._frames_ignored += 1   # inactive: counted apart, never masked
             return
         received = time.monotonic()
-        stamp = msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec
+        stamp = 1e-9 * stamp_ns(msg.header)
         self._stats.received(stamp or None)     # an unset (zero) stamp says nothing
         advice = self._large_images.check(len(msg.data))
         if advice:

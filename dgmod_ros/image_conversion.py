@@ -43,6 +43,11 @@ class ImageConversionError(ValueError):
         self.reason = reason
 
 
+def stamp_ns(header):
+    """Return a ``std_msgs/Header``'s stamp in integer nanoseconds."""
+    return header.stamp.sec * 1_000_000_000 + header.stamp.nanosec
+
+
 def image_to_array(msg, max_pixels=None, allow_non_finite=False):
     """
     Return the pixels of an Image message as a new ``(h, w)`` or ``(h, w, c)`` array.
