@@ -253,7 +253,8 @@ class SlidingWindowDetector(StreamingDetector):
             if self.decision == 'global':
                 residual = columns - background
                 return background, self.mask_rule_.estimate_threshold(residual, buffered)
-            return background, warmup_noise(buffered)
+            # The frame itself counts: with one frame buffered there is no other difference.
+            return background, warmup_noise(np.concatenate((buffered, columns[:, :, None]), axis=2))
         background = robust_projection(model.basis, columns)
         if self.decision == 'global':
             return background, model.threshold
