@@ -266,7 +266,8 @@ class SlidingWindowDetector(StreamingDetector):
                 residual = columns - background
                 return background, self.mask_rule_.estimate_threshold(residual, buffered)
             # The frame itself counts: with one frame buffered there is no other difference.
-            return background, warmup_noise(np.concatenate((buffered, columns[:, :, None]), axis=2))
+            with_frame = np.concatenate((buffered, columns[:, :, None]), axis=2)
+            return background, warmup_noise(with_frame)
         background = robust_projection(model.basis, columns)
         if self.decision == 'global':
             return background, model.threshold
