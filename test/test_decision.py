@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from dgmod_ros.core.streaming import SlidingWindowDetector
+from dgmod_ros.core.streaming.coherence import mean_field_mask
 from dgmod_ros.core.streaming.foreground import warmup_noise
 from dgmod_ros.core.streaming.held_foreground import still_age, still_blob_pixels
 
@@ -70,7 +71,7 @@ def test_still_age_counts_consecutive_still_frames_and_restarts():
 
 def _box_scene(ghost, frames=150, change=40):
     """
-    A textured wall and a plain dark box.
+    Yield frames of a textured wall and a plain dark box.
 
     ``ghost``: the box is there in the first ``change`` frames (the window learns
     it) and leaves. Otherwise it arrives at frame ``change`` and stays, a part of
@@ -105,3 +106,33 @@ def test_a_ghost_that_uncovers_texture_is_dropped_after_still_frames():
 
 def test_a_stopped_object_that_moves_a_little_is_kept():
     assert _held_share(30, ghost=False) > 0.9
+
+
+def _field(z_image, beta):
+    rows, cols = z_image.shape
+    return mean_field_mask(z_image.ravel() * 0.01, 0.01, 6.0, beta, (rows, cols, 3))
+
+
+def test_mean_field_without_coupling_is_the_k_sigma_rule():
+    z = np.random.default_rng(1).uniform(0, 12, (20, 30)).astype(np.float32)
+    assert np.array_equal(_field(z, 0.0) > 0, z > 6.0)
+
+
+def test_mean_field_drops_a_lone_pixel_just_over_and_keeps_a_strong_one():
+    z = np.full((20, 30), 2.0, np.float32)
+    z[5, 5] = 6.5               # just over the threshold, background around
+    z[14, 20] = 18.0            # a small far person: far over it
+    mask = _field(z, 2.0) > 0
+    assert not mask[5, 5]
+    assert mask[14, 20]
+    assert mask.sum() == 1
+
+
+def test_mean_field_fills_a_weak_pixel_inside_a_silhouette():
+    z = np.full((20, 30), 1.0, np.float32)
+    z[4:16, 10:18] = 9.0
+    z[9, 13] = 5.0              # just under the threshold, foreground around
+    mask = _field(z, 2.0) > 0
+    assert mask[9, 13]
+    assert mask[4:16, 10:18].all()
+    assert mask.sum() == 12 * 8

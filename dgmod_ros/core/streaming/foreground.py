@@ -28,6 +28,7 @@ the 0/255 mask, thresholded at half.
 import cv2
 import numpy as np
 
+from .coherence import mean_field_mask
 from ..masks import robust_sigma
 
 #: Observations a pixel needs for its own noise level.
@@ -98,7 +99,7 @@ def warmup_noise(buffered):
     return max(_MAD_TO_SIGMA * float(np.median(differences)) / np.sqrt(2.0), _QUANTUM)
 
 
-def adaptive_mask(columns, background, noise, k, shape, median_size):
+def adaptive_mask(columns, background, noise, k, shape, median_size, mrf_beta=0.0):
     """
     Return a frame's foreground at the processing size (uint8 0/255) and its distance.
 
@@ -114,10 +115,16 @@ def adaptive_mask(columns, background, noise, k, shape, median_size):
         Processing shape.
     median_size : int
         Side of the median filter (odd); <= 1 disables it.
+    mrf_beta : float
+        > 0: the Potts field of :func:`~dgmod_ros.core.streaming.coherence.mean_field_mask`
+        with this coupling decides instead of the threshold and the median filter.
 
     """
     rows, cols = shape[:2]
     distance = np.abs(columns - background).max(axis=0)
+    if mrf_beta > 0:
+        mask = mean_field_mask(distance, noise, k, mrf_beta, shape)
+        return mask, distance.reshape(rows, cols)
     mask = np.where(distance > k * noise, np.uint8(255), np.uint8(0)).reshape(rows, cols)
     if median_size > 1:
         mask = cv2.medianBlur(mask, int(median_size))

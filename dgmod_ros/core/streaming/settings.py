@@ -54,6 +54,8 @@ def check_window_parameters(detector):
     still = detector.still_frames
     if int(still) != still or still < 0:
         raise ValueError(f'still_frames must be an integer >= 0, got {still!r}')
+    if not (np.isfinite(detector.mrf_beta) and detector.mrf_beta >= 0):
+        raise ValueError(f'mrf_beta must be >= 0, got {detector.mrf_beta!r}')
     (detector.mask_rule or MaskRule()).validate()
 
 

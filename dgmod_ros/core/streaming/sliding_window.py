@@ -122,6 +122,11 @@ class SlidingWindowDetector(StreamingDetector):
         5 frames before) for this many consecutive frames; they enter the
         window as they are (ghosts that uncover texture, see
         :mod:`~dgmod_ros.core.streaming.held_foreground`). 0 disables.
+    mrf_beta : float, default=2.0
+        > 0: the adaptive decision is a Potts field over the ``pixel_k``-sigma
+        rule, coupling 5 x 5 neighbours with this weight (log-odds per
+        neighbour; :mod:`~dgmod_ros.core.streaming.coherence`), in place of
+        the median filter; 0: threshold and median filter.
 
     Attributes
     ----------
@@ -141,7 +146,7 @@ class SlidingWindowDetector(StreamingDetector):
                  mask_rule=None, motion_threshold=0.0, min_frames=5, basis_rank=2,
                  global_change_fraction=0.7, memory_spacing=10, conditional_update=True,
                  absorb_frames=300, decision='adaptive', pixel_k=6.0, median_size=5,
-                 ghost_test=True, still_frames=50):
+                 ghost_test=True, still_frames=50, mrf_beta=2.0):
         self.model = model
         self.window = window
         self.stride = stride
@@ -160,6 +165,7 @@ class SlidingWindowDetector(StreamingDetector):
         self.median_size = median_size
         self.ghost_test = ghost_test
         self.still_frames = still_frames
+        self.mrf_beta = mrf_beta
         self._validated = False
 
     # ------------------------------------------------------------- set-up
@@ -285,7 +291,8 @@ class SlidingWindowDetector(StreamingDetector):
             foreground = np.where(result.magnitude > level, np.uint8(255), np.uint8(0))
         else:
             foreground, result.magnitude = adaptive_mask(
-                columns, background, level, self.pixel_k, self.shape_, self.median_size)
+                columns, background, level, self.pixel_k, self.shape_, self.median_size,
+                self.mrf_beta)
             if (self.ghost_test and self.background_model_ is not None
                     and len(self.recent_) == self.recent_.maxlen):
                 ghosts = ghost_blobs(foreground, columns, background, self.recent_[0][1],
