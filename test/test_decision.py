@@ -2,13 +2,12 @@
 # Licensed under the Apache License, Version 2.0
 """The streaming decision's pieces: warm-up noise level, still blobs, held ghosts."""
 
-import numpy as np
-import pytest
-
 from dgmod_ros.core.streaming import SlidingWindowDetector
 from dgmod_ros.core.streaming.coherence import mean_field_mask
 from dgmod_ros.core.streaming.foreground import warmup_noise
 from dgmod_ros.core.streaming.held_foreground import still_age, still_blob_pixels
+import numpy as np
+import pytest
 
 
 def test_warmup_noise_reads_the_size_of_the_differences_not_their_spread():
