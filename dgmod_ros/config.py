@@ -109,6 +109,12 @@ PARAMETERS = (
               choices=('adaptive', 'uniform', 'global')),
     Parameter('ghost_test', True, 'drop still blobs whose outline is an edge of the background '
               'rather than of the frame (ghosts of what has left); they heal the window'),
+    Parameter('still_frames', 50, 'drop pixels that have been in a still blob (nothing in it '
+              'changed by pixel_k / 2 noise levels over 5 frames) for this many frames: ghosts '
+              'that uncover texture; they heal the window; 0 = off', 0, 1000000),
+    Parameter('mrf_beta', 2.0, 'coupling of 5 x 5 neighbours in the Potts field that decides '
+              'the adaptive mask (log-odds per neighbour, mean field); 0 = threshold and '
+              'median filter', 0.0, 100.0),
     Parameter('pixel_k', 6.0, 'multiple of the noise level that makes a pixel foreground '
               '(adaptive, uniform)', 0.1, 100.0),
     Parameter('median_size', 5, 'median filter of the adaptive decision at the processing '
@@ -232,7 +238,8 @@ def detector_settings(values):
             'conditional_update': values['conditional_update'],
             'absorb_frames': values['absorb_frames'], 'decision': values['decision'],
             'pixel_k': values['pixel_k'], 'median_size': values['median_size'],
-            'ghost_test': values['ghost_test']}
+            'ghost_test': values['ghost_test'], 'still_frames': values['still_frames'],
+            'mrf_beta': values['mrf_beta']}
 
 
 def validate(values):

@@ -28,6 +28,7 @@ the 0/255 mask, thresholded at half.
 import cv2
 import numpy as np
 
+from .coherence import mean_field_mask
 from ..masks import robust_sigma
 
 #: Observations a pixel needs for its own noise level.
@@ -80,14 +81,25 @@ def pixel_noise(residual, shape, observed=None, uniform=False):
 
 
 def warmup_noise(buffered):
-    """Return one noise level for every pixel before the first solve, from frame differences."""
+    """
+    Return one noise level for every pixel before the first solve, from frame differences.
+
+    The level is read like :func:`pixel_noise` reads the residual: 1.4826
+    times the median magnitude (largest over the channels) of the
+    differences of consecutive buffered frames, over all pixels, divided by
+    sqrt(2) (a difference holds the noise of two frames). The magnitudes are
+    not centred on their median first: their spread around their median
+    says how alike they are, not how large, and a frame-wide change of a few
+    grey levels (an exposure step between the first frames) then gave a
+    level near 0 and a mask full of specks.
+    """
     if buffered.shape[-1] < 2:
         return _QUANTUM
     differences = np.abs(np.diff(buffered, axis=-1)).max(axis=0)
-    return max(robust_sigma(differences) / np.sqrt(2.0), _QUANTUM)
+    return max(_MAD_TO_SIGMA * float(np.median(differences)) / np.sqrt(2.0), _QUANTUM)
 
 
-def adaptive_mask(columns, background, noise, k, shape, median_size):
+def adaptive_mask(columns, background, noise, k, shape, median_size, mrf_beta=0.0):
     """
     Return a frame's foreground at the processing size (uint8 0/255) and its distance.
 
@@ -103,10 +115,16 @@ def adaptive_mask(columns, background, noise, k, shape, median_size):
         Processing shape.
     median_size : int
         Side of the median filter (odd); <= 1 disables it.
+    mrf_beta : float
+        > 0: the Potts field of :func:`~dgmod_ros.core.streaming.coherence.mean_field_mask`
+        with this coupling decides instead of the threshold and the median filter.
 
     """
     rows, cols = shape[:2]
     distance = np.abs(columns - background).max(axis=0)
+    if mrf_beta > 0:
+        mask = mean_field_mask(distance, noise, k, mrf_beta, shape)
+        return mask, distance.reshape(rows, cols)
     mask = np.where(distance > k * noise, np.uint8(255), np.uint8(0)).reshape(rows, cols)
     if median_size > 1:
         mask = cv2.medianBlur(mask, int(median_size))

@@ -51,6 +51,11 @@ def check_window_parameters(detector):
     size = detector.median_size
     if int(size) != size or size < 1 or size % 2 == 0:
         raise ValueError(f'median_size must be an odd positive integer, got {size!r}')
+    still = detector.still_frames
+    if int(still) != still or still < 0:
+        raise ValueError(f'still_frames must be an integer >= 0, got {still!r}')
+    if not (np.isfinite(detector.mrf_beta) and detector.mrf_beta >= 0):
+        raise ValueError(f'mrf_beta must be >= 0, got {detector.mrf_beta!r}')
     (detector.mask_rule or MaskRule()).validate()
 
 

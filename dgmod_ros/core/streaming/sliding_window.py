@@ -17,6 +17,7 @@ from .buffer import SceneChangeWatch
 from .contract import StreamingDetector
 from .fast_path import robust_projection
 from .foreground import adaptive_mask, ghost_blobs, to_input_size, warmup_noise
+from .held_foreground import still_age, still_blob_pixels
 from .results import FrameResult, WindowSnapshot
 from .settings import assign_validated, check_window_parameters
 from .window_solve import solve_window
@@ -28,6 +29,8 @@ from ..preprocess import frame_columns, processing_shape
 _GHOST_LAG = 5
 # Growth of the foreground before the conditional update (processing pixels).
 _BORDER_KERNEL = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (5, 5))
+# Largest share of a blob's pixels that may change for the blob to count as still.
+_STILL_SHARE = 0.01
 
 
 class SlidingWindowDetector(StreamingDetector):
@@ -113,6 +116,17 @@ class SlidingWindowDetector(StreamingDetector):
         than of the frame (something in the window's frames has left; see
         :func:`~dgmod_ros.core.streaming.foreground.ghost_blobs`); their
         pixels enter the window as they are, which heals the background.
+    still_frames : int, default=50
+        Drop pixels that have been in a still blob (at most 1 % of its pixels
+        changed by more than ``pixel_k / 2`` noise levels against the frame
+        5 frames before) for this many consecutive frames; they enter the
+        window as they are (ghosts that uncover texture, see
+        :mod:`~dgmod_ros.core.streaming.held_foreground`). 0 disables.
+    mrf_beta : float, default=2.0
+        > 0: the adaptive decision is a Potts field over the ``pixel_k``-sigma
+        rule, coupling 5 x 5 neighbours with this weight (log-odds per
+        neighbour; :mod:`~dgmod_ros.core.streaming.coherence`), in place of
+        the median filter; 0: threshold and median filter.
 
     Attributes
     ----------
@@ -132,7 +146,7 @@ class SlidingWindowDetector(StreamingDetector):
                  mask_rule=None, motion_threshold=0.0, min_frames=5, basis_rank=2,
                  global_change_fraction=0.7, memory_spacing=10, conditional_update=True,
                  absorb_frames=300, decision='adaptive', pixel_k=6.0, median_size=5,
-                 ghost_test=True):
+                 ghost_test=True, still_frames=50, mrf_beta=2.0):
         self.model = model
         self.window = window
         self.stride = stride
@@ -150,6 +164,8 @@ class SlidingWindowDetector(StreamingDetector):
         self.pixel_k = pixel_k
         self.median_size = median_size
         self.ghost_test = ghost_test
+        self.still_frames = still_frames
+        self.mrf_beta = mrf_beta
         self._validated = False
 
     # ------------------------------------------------------------- set-up
@@ -209,6 +225,7 @@ class SlidingWindowDetector(StreamingDetector):
             self.background_pending_ = False
             self.recent_.clear()            # frames of the old size
             self.foreground_age_ = None
+            self.still_age_ = None
         return self
 
     def reset(self):
@@ -216,6 +233,7 @@ class SlidingWindowDetector(StreamingDetector):
         self._new_generation()
         self.buffer_ = BackgroundMemory(int(self.window), int(self.memory_spacing))
         self.foreground_age_ = None
+        self.still_age_ = None
         self.recent_ = deque(maxlen=_GHOST_LAG)
         self.scene_watch_ = SceneChangeWatch()
         self.background_model_ = None
@@ -253,7 +271,9 @@ class SlidingWindowDetector(StreamingDetector):
             if self.decision == 'global':
                 residual = columns - background
                 return background, self.mask_rule_.estimate_threshold(residual, buffered)
-            return background, warmup_noise(buffered)
+            # The frame itself counts: with one frame buffered there is no other difference.
+            with_frame = np.concatenate((buffered, columns[:, :, None]), axis=2)
+            return background, warmup_noise(with_frame)
         background = robust_projection(model.basis, columns)
         if self.decision == 'global':
             return background, model.threshold
@@ -271,12 +291,16 @@ class SlidingWindowDetector(StreamingDetector):
             foreground = np.where(result.magnitude > level, np.uint8(255), np.uint8(0))
         else:
             foreground, result.magnitude = adaptive_mask(
-                columns, background, level, self.pixel_k, self.shape_, self.median_size)
+                columns, background, level, self.pixel_k, self.shape_, self.median_size,
+                self.mrf_beta)
             if (self.ghost_test and self.background_model_ is not None
                     and len(self.recent_) == self.recent_.maxlen):
                 ghosts = ghost_blobs(foreground, columns, background, self.recent_[0][1],
                                      level, self.pixel_k)
                 foreground[ghosts] = 0
+            if (self.still_frames and self.background_model_ is not None
+                    and len(self.recent_) == self.recent_.maxlen):
+                self._drop_still(foreground, columns, level)
             result.mask = to_input_size(foreground, self.input_shape_)
         result.buffered = self._admit(columns, background, foreground, result.frame_id)
         self.recent_.append((result.frame_id, columns))
@@ -287,6 +311,13 @@ class SlidingWindowDetector(StreamingDetector):
                                                            self.global_change_fraction):
             self._restart_from_newest(SceneChangeWatch.FRAMES)
         return result
+
+    def _drop_still(self, foreground, columns, level):
+        """Clear, in place, the pixels of ``foreground`` held still for ``still_frames``."""
+        still = still_blob_pixels(foreground, columns, self.recent_[0][1], level,
+                                  self.pixel_k / 2, _STILL_SHARE)
+        self.still_age_ = still_age(self.still_age_, still)
+        foreground[self.still_age_.reshape(foreground.shape) >= self.still_frames] = 0
 
     def _admit(self, columns, background, foreground, frame_id):
         """Put the frame into the window if due (conditionally); return whether it went in."""
@@ -319,6 +350,7 @@ class SlidingWindowDetector(StreamingDetector):
             self.buffer_.append(columns, frame_id)
         self.since_solve_ = len(self.buffer_)
         self.foreground_age_ = None
+        self.still_age_ = None
         self.background_model_ = None
         self.background_pending_ = False
         self.scene_changes_ += 1

@@ -1,0 +1,66 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""
+Foreground that nothing moves in: the ghosts the conditional update would hold.
+
+The conditional update (:mod:`~dgmod_ros.core.streaming.background_memory`)
+keeps a frame's foreground out of the window so that a person who stops stays
+foreground. Its blind spot is a ghost: something that was in the window's
+frames when the model was learnt (a person standing in the first frames)
+leaves, the place it uncovers is foreground, and being foreground it is never
+admitted, so the window keeps the departed object until ``absorb_frames``
+pass. The ghost test of :func:`~dgmod_ros.core.streaming.foreground.ghost_blobs`
+catches a ghost whose outline is an edge of the background; one that
+uncovers texture (a railing behind a plain sweater) has the stronger edges
+in the frame and passes for an object.
+
+What a ghost has and a stopped person has not is stillness: the uncovered
+background holds only sensor noise, while a seated person breathes, turns a
+head, shifts a hand. A blob is *still* when at most ``share`` of its pixels
+changed by more than ``k`` noise levels against the frame a few frames
+before. A pixel that has been in a still blob for ``still_frames``
+consecutive frames is dropped from the mask and enters the window as it is,
+which heals the background; a real object left behind and never touched
+(a bag) goes the same way, earlier than ``absorb_frames``.
+"""
+
+import cv2
+import numpy as np
+
+
+def still_blob_pixels(mask, frame, earlier, noise, k, share):
+    """
+    Return the pixels (rows, cols) bool of foreground blobs in which nothing moved.
+
+    Parameters
+    ----------
+    mask : ndarray (rows, cols) uint8
+        The frame's foreground at the processing size.
+    frame, earlier : ndarray (C, n)
+        The frame and a frame a few frames before.
+    noise : ndarray (n,) or float
+        Each pixel's noise level.
+    k : float
+        Multiple of the noise level that counts as a change.
+    share : float
+        Largest share of a blob's pixels that may change for the blob to be still.
+
+    """
+    count, labels = cv2.connectedComponents(mask, connectivity=8)
+    if count <= 1:
+        return np.zeros(mask.shape, dtype=bool)
+    flat = labels.ravel()
+    moved = np.abs(frame - earlier).max(axis=0) > k * noise
+    moving_share = (np.bincount(flat, moved, minlength=count)
+                    / np.maximum(np.bincount(flat, minlength=count), 1))
+    still = moving_share <= share
+    still[0] = False
+    return still[labels]
+
+
+def still_age(previous, still):
+    """Return the consecutive frames (n,) int32 each pixel has been in a still blob."""
+    still = np.asarray(still).ravel()
+    if previous is None or previous.shape != still.shape:
+        previous = np.zeros(still.shape, dtype=np.int32)
+    return np.where(still, previous + 1, 0).astype(np.int32)

@@ -1,0 +1,137 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""The streaming decision's pieces: warm-up noise level, still blobs, held ghosts."""
+
+from dgmod_ros.core.streaming import SlidingWindowDetector
+from dgmod_ros.core.streaming.coherence import mean_field_mask
+from dgmod_ros.core.streaming.foreground import warmup_noise
+from dgmod_ros.core.streaming.held_foreground import still_age, still_blob_pixels
+import numpy as np
+import pytest
+
+
+def test_warmup_noise_reads_the_size_of_the_differences_not_their_spread():
+    rng = np.random.default_rng(0)
+    first = rng.uniform(0.2, 0.8, (3, 500)).astype(np.float32)
+    # An exposure step of 0.05 everywhere plus noise of 0.002: the differences
+    # are alike (small spread) but large, and the level must say large.
+    second = first + 0.05 + rng.normal(0, 0.002, first.shape).astype(np.float32)
+    level = warmup_noise(np.stack([first, second], axis=2))
+    assert level == pytest.approx(1.4826 * 0.05 / np.sqrt(2), rel=0.1)
+
+
+def test_warmup_noise_of_one_frame_is_the_quantum():
+    assert warmup_noise(np.zeros((3, 10, 1), np.float32)) == pytest.approx(1 / 255)
+
+
+def _two_blobs():
+    mask = np.zeros((20, 30), np.uint8)
+    mask[2:8, 2:8] = 255            # blob A
+    mask[10:18, 15:25] = 255        # blob B
+    return mask
+
+
+def test_still_blob_pixels_marks_only_blobs_in_which_nothing_changed():
+    mask = _two_blobs()
+    earlier = np.zeros((3, mask.size), np.float32)
+    frame = earlier.copy()
+    changed = np.zeros(mask.shape, bool)
+    changed[12:15, 18:22] = True    # 12 of blob B's 80 pixels move
+    frame[:, changed.ravel()] = 0.5
+    still = still_blob_pixels(mask, frame, earlier, 0.01, 3.0, 0.01)
+    assert still[2:8, 2:8].all()
+    assert not still[10:18, 15:25].any()
+    assert not still[mask == 0].any()
+
+
+def test_still_blob_pixels_allows_the_given_share_of_changed_pixels():
+    mask = _two_blobs()
+    earlier = np.zeros((3, mask.size), np.float32)
+    frame = earlier.copy()
+    frame[:, np.ravel_multi_index(([12], [18]), mask.shape)] = 0.5   # 1 of 80 pixels
+    assert still_blob_pixels(mask, frame, earlier, 0.01, 3.0, 0.02)[10:18, 15:25].all()
+    assert not still_blob_pixels(mask, frame, earlier, 0.01, 3.0, 0.01)[10:18, 15:25].any()
+
+
+def test_still_blob_pixels_of_an_empty_mask_is_empty():
+    mask = np.zeros((4, 5), np.uint8)
+    columns = np.zeros((1, 20), np.float32)
+    assert not still_blob_pixels(mask, columns, columns, 0.01, 3.0, 0.01).any()
+
+
+def test_still_age_counts_consecutive_still_frames_and_restarts():
+    age = still_age(None, np.array([True, False, True]))
+    age = still_age(age, np.array([True, True, False]))
+    assert age.tolist() == [2, 1, 0]
+    assert age.dtype == np.int32
+    # A new size (the scale changed) starts over.
+    assert still_age(age, np.array([True, True])).tolist() == [1, 1]
+
+
+def _box_scene(ghost, frames=150, change=40):
+    """
+    Yield frames of a textured wall and a plain dark box.
+
+    ``ghost``: the box is there in the first ``change`` frames (the window learns
+    it) and leaves. Otherwise it arrives at frame ``change`` and stays, a part of
+    it moving a little (a stopped person's hand or head).
+    """
+    rng = np.random.default_rng(3)
+    wall = rng.uniform(0.3, 0.9, (48, 64, 3)).astype(np.float32)
+    for index in range(frames):
+        image = wall + rng.normal(0, 0.004, wall.shape).astype(np.float32)
+        if (index < change) == ghost:
+            image[16:36, 20:44] = 0.1
+            if not ghost:
+                row = 16 + 2 * (index % 7)     # a period other than the 5-frame lag
+                image[row:row + 4, 20:26] = 0.6
+        yield np.clip(image, 0, 1)
+
+
+def _held_share(still_frames, ghost):
+    detector = SlidingWindowDetector(ghost_test=False, still_frames=still_frames)
+    masks = [detector.process(image)[0].mask for image in _box_scene(ghost)]
+    box = np.zeros(masks[0].shape, bool)
+    box[18:34, 22:42] = True
+    return np.mean([m[box].mean() / 255 for m in masks[-10:]])
+
+
+def test_a_ghost_that_uncovers_texture_is_dropped_after_still_frames():
+    # The box is in the frames the window first learns, then leaves: its place is
+    # foreground that the conditional update would hold for absorb_frames.
+    assert _held_share(0, ghost=True) > 0.9
+    assert _held_share(30, ghost=True) < 0.05
+
+
+def test_a_stopped_object_that_moves_a_little_is_kept():
+    assert _held_share(30, ghost=False) > 0.9
+
+
+def _field(z_image, beta):
+    rows, cols = z_image.shape
+    return mean_field_mask(z_image.ravel() * 0.01, 0.01, 6.0, beta, (rows, cols, 3))
+
+
+def test_mean_field_without_coupling_is_the_k_sigma_rule():
+    z = np.random.default_rng(1).uniform(0, 12, (20, 30)).astype(np.float32)
+    assert np.array_equal(_field(z, 0.0) > 0, z > 6.0)
+
+
+def test_mean_field_drops_a_lone_pixel_just_over_and_keeps_a_strong_one():
+    z = np.full((20, 30), 2.0, np.float32)
+    z[5, 5] = 6.5               # just over the threshold, background around
+    z[14, 20] = 18.0            # a small far person: far over it
+    mask = _field(z, 2.0) > 0
+    assert not mask[5, 5]
+    assert mask[14, 20]
+    assert mask.sum() == 1
+
+
+def test_mean_field_fills_a_weak_pixel_inside_a_silhouette():
+    z = np.full((20, 30), 1.0, np.float32)
+    z[4:16, 10:18] = 9.0
+    z[9, 13] = 5.0              # just under the threshold, foreground around
+    mask = _field(z, 2.0) > 0
+    assert mask[9, 13]
+    assert mask[4:16, 10:18].all()
+    assert mask.sum() == 12 * 8
