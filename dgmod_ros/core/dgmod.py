@@ -121,11 +121,12 @@ class DualGraphMOD:
         'gram' takes the thin SVD through the m x m Gram matrix; 'full' calls
         LAPACK on the tall matrix (the literal reference).
     engine : {'fused', 'numpy'}, default='fused'
-        'fused' runs a sweep as two compiled, multi-threaded passes
-        (:mod:`dgmod_ros.core.kernels`); 'numpy' is the literal formulation,
-        one numpy expression per step, which the tests compare it with. Both
-        give the same iterates to float32 rounding. ``svd='full'`` (the literal
-        reference) always runs the numpy formulation.
+        'fused' runs a sweep as one compiled, multi-threaded pass and the
+        BLAS products of the SVT (:mod:`dgmod_ros.core.kernels`); 'numpy' is
+        the literal formulation, one numpy expression per step, which the
+        tests compare it with. Both give the same iterates to float32
+        rounding. ``svd='full'`` (the literal reference) always runs the
+        numpy formulation.
     tol : float, default=1e-4
         Stop when the relative changes of L and S and the relative primal
         residuals ``||U - L|| / ||D||``, ``||D - L - S - V|| / ||D||`` are all
