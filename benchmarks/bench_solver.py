@@ -8,7 +8,8 @@ scene when ../shared/data is absent), float32, tol 1e-4. Prints the median
 time of the solver (fused numba sweep, the default), of the same sweep in numpy
 (engine='numpy') and of the literal reference of the printed steps (numpy,
 gradient L-step, full SVD of the tall matrix) in the same process, the ratios,
-the F-measures against ground truth, and peak memory. The process runs OpenBLAS
+the F-measures against ground truth, the objective values reached
+(``DualGraphMOD.objective``) and peak memory. The process runs OpenBLAS
 on one thread once the fused kernels are loaded (dgmod_ros.core.kernels), so all
 three are timed that way; the first fused solve (numba compile or cache load)
 is timed apart.
@@ -109,15 +110,20 @@ def main(argv=None):
                              svd='full'),
         data, args.reference_repeats)
     fast_median = statistics.median(fast_times)
-    scores = {}
+    scores, objectives = {}, {}
     for name, times, model in (('fused solver (default)', fast_times, fast),
                                ('numpy sweep', numpy_times, numpy_model),
                                ('literal reference', ref_times, ref)):
         median = statistics.median(times)
         scores[name] = fmeasure(model, data, masks)
+        objectives[name] = model.objective(data, SHAPE)
         print(f'{name:<23}: median {median:.3f} s over {len(times)} runs (min '
               f'{min(times):.3f}; {model.n_iter_} sweeps, info {model.info_}, '
-              f'{1e3 * median / model.n_iter_:.1f} ms/sweep), F {scores[name]:.3f}')
+              f'{1e3 * median / model.n_iter_:.1f} ms/sweep), F {scores[name]:.3f}, '
+              f'objective {objectives[name]:.2f}')
+    gap = abs(objectives['fused solver (default)'] - objectives['literal reference'])
+    print(f'objective, fused against the literal reference: relative difference '
+          f"{gap / abs(objectives['literal reference']):.1e}")
     for name, times, model in (('numpy sweep', numpy_times, numpy_model),
                                ('literal reference', ref_times, ref)):
         ratio = statistics.median(times) / fast_median

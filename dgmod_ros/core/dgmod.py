@@ -7,7 +7,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .graphs import spatial_laplacian, temporal_laplacian
-from .linalg import (drop_oldest, mixing_factors, relative_change, shrink,
+from .linalg import (drop_oldest, gram_eigh, mixing_factors, relative_change, shrink,
                      singular_value_map, top_singular_value)
 from .runtime import limit_blas_threads
 from .window_data import check_window_data
@@ -121,11 +121,12 @@ class DualGraphMOD:
         'gram' takes the thin SVD through the m x m Gram matrix; 'full' calls
         LAPACK on the tall matrix (the literal reference).
     engine : {'fused', 'numpy'}, default='fused'
-        'fused' runs a sweep as two compiled, multi-threaded passes
-        (:mod:`dgmod_ros.core.kernels`); 'numpy' is the literal formulation,
-        one numpy expression per step, which the tests compare it with. Both
-        give the same iterates to float32 rounding. ``svd='full'`` (the literal
-        reference) always runs the numpy formulation.
+        'fused' runs a sweep as one compiled, multi-threaded pass and the
+        BLAS products of the SVT (:mod:`dgmod_ros.core.kernels`); 'numpy' is
+        the literal formulation, one numpy expression per step, which the
+        tests compare it with. Both give the same iterates to float32
+        rounding. ``svd='full'`` (the literal reference) always runs the
+        numpy formulation.
     tol : float, default=1e-4
         Stop when the relative changes of L and S and the relative primal
         residuals ``||U - L|| / ||D||``, ``||D - L - S - V|| / ||D||`` are all
@@ -376,12 +377,13 @@ class DualGraphMOD:
 
     def _run_fused(self, data, ops, iterates, history, data_norm):
         """
-        Sweep with the compiled passes of :mod:`dgmod_ros.core.kernels`.
+        Sweep with the compiled pass of :mod:`dgmod_ros.core.kernels`.
 
         The same steps as :meth:`_run_numpy` in the same order, the same
         iterates and the same stopping sweep; after the primal pass BLAS forms
         the Gram matrix of ``Lh = L - Y1`` and the SVT as the rank-k product
-        ``U = (Lh left) right_t``; the dual updates ride on the next primal pass.
+        ``U = (Lh left) right_t``. ``Y1`` lives as ``U - Lh`` (kernels module
+        docstring) and is formed once, at the end.
         """
         from . import kernels       # numba compiles or loads its cache on first use
         # Again at every solve: an OpenBLAS loaded since (scipy.linalg's) must
@@ -391,7 +393,8 @@ class DualGraphMOD:
         def contiguous(array):      # fit's copies already are; no second copy
             return np.require(array, np.float32, ['C', 'W'])
 
-        L, S, U, V, Y1, Y2 = (contiguous(iterates[k]) for k in ('L', 'S', 'U', 'V', 'Y1', 'Y2'))
+        L, S, U, V, Y2 = (contiguous(iterates[k]) for k in ('L', 'S', 'U', 'V', 'Y2'))
+        Lh = U - iterates['Y1']     # so that U - Lh is the given Y1
         weights, sigma = iterates['weights'], iterates['sigma']
         rho1, rho2 = float(self.rho1), float(self.rho2)
         g1, g2, c = float(self.gamma1), float(self.gamma2), rho1 + rho2
@@ -402,45 +405,49 @@ class DualGraphMOD:
         t_offsets, t_bands = kernels.diagonal_bands(ops['phi_t'])
         # Other L-steps than one gradient step run in numpy and hand L_new over.
         l_given = not (self.l_step == 'gradient' and self.inner_iter == 1)
-        L_new, S_new, V_new, Lh = (np.empty_like(data) for _ in range(4))
-        rhs = work = None
+        L_new, S_new = np.empty_like(data), np.empty_like(data)
+        rhs = work = Y1 = None
         threshold = self.lambda1_ / rho1
-        # The dual updates of a sweep run at the start of the next primal pass
-        # (one pass a sweep); its stopping figures are known only then, so a
-        # sweep that meets the rule costs one primal pass whose results are
-        # dropped. The numpy L-steps need the updated duals first: no merge.
-        merge = not l_given
-        pending = None      # (change_L, change_S, rank) of a sweep whose dual update waits
+        # A sweep's residual ||U - L|| needs its SVT, so the next pass sums it;
+        # only when every other figure of the rule is already below tol is it
+        # summed at once (the pass updates V, Y2 and Lh in place: it must not
+        # run past the stopping sweep).
+        pending = None      # (change_L, change_S, residual_V, rank) of the last sweep
 
-        def finish(squared_residuals):
-            residual_U, residual_V = np.sqrt(squared_residuals) / data_norm
-            return self._record(history, pending[0], pending[1], float(residual_U),
-                                float(residual_V), pending[2])
+        def finish(squared_gap):
+            change_L, change_S, residual_V, rank = pending
+            return self._record(history, change_L, change_S,
+                                float(np.sqrt(squared_gap)) / data_norm, residual_V, rank)
 
         for _ in range(self.max_iter):
-            if pending is not None and not merge:
-                stop = finish(kernels.dual_pass(data, L, S, V, U, Y1, Y2))
+            if pending is not None and max(pending[:3]) < self.tol:
+                stop = finish(kernels.squared_gap(U, L))
                 pending = None
                 if stop:
                     self.info_ = 0
                     break
             if l_given:
                 if rhs is None:
-                    rhs, work = np.empty_like(data), np.empty_like(data)
+                    rhs, work, Y1 = (np.empty_like(data) for _ in range(3))
+                np.subtract(U, Lh, out=Y1)
                 self._l_rhs(data, U, Y1, S, V, Y2, rhs, work)
                 np.copyto(L_new, self._l_step(rhs, L, ops, c))
             sums = kernels.primal_pass(
-                data, L, U, Y1, S, V, Y2, s_offsets, s_bands, t_offsets, t_bands,
-                coefficients, l_given, pending is not None, L_new, S_new, V_new, Lh)
+                data, L, U, Lh, S, V, Y2, s_offsets, s_bands, t_offsets, t_bands,
+                coefficients, l_given, L_new, S_new)
             if pending is not None:
-                stop = finish(sums[4:])
+                finish(sums[4])     # not below tol: pending's own figures are not
                 pending = None
-                if stop:
-                    self.info_ = 0
-                    break
             gram = Lh.T @ Lh
             if not (np.isfinite(gram).all() and np.isfinite(sums[:4]).all()):
-                self.info_ = -1     # L_new, S_new, V_new are dropped
+                # L and S are the last finite iterate; V, Y2 and Lh were
+                # overwritten in place: the state restarts U, V and the duals
+                # (U = L, V = Y1 = Y2 = 0) instead of handing them over.
+                self.info_ = -1
+                U[...] = L
+                Lh[...] = L
+                V[...] = 0.0
+                Y2[...] = 0.0
                 break
             if threshold == 0:      # no nuclear norm (FRPCAG): the prox is the identity
                 left = right_t = np.eye(data.shape[1], dtype=np.float32)
@@ -451,12 +458,13 @@ class DualGraphMOD:
             weights = np.exp(-(sigma / self.weight_scale_) ** 2).astype(np.float32)
             L, L_new = L_new, L
             S, S_new = S_new, S
-            V, V_new = V_new, V
             np.matmul(Lh @ left.astype(np.float32), right_t.astype(np.float32), out=U)
-            pending = (_ratio(sums[0], sums[1]), _ratio(sums[2], sums[3]), rank)
-        if pending is not None and finish(kernels.dual_pass(data, L, S, V, U, Y1, Y2)):
-            self.info_ = 0          # the last sweep's dual update, after the loop
-        iterates.update(L=L, S=S, U=U, V=V, Y1=Y1, Y2=Y2, weights=weights, sigma=sigma)
+            pending = (_ratio(sums[0], sums[1]), _ratio(sums[2], sums[3]),
+                       float(np.sqrt(sums[5])) / data_norm, rank)
+        if pending is not None and finish(kernels.squared_gap(U, L)):
+            self.info_ = 0          # the last sweep's residual, after the loop
+        iterates.update(L=L, S=S, U=U, V=V, Y1=np.subtract(U, Lh, out=Lh), Y2=Y2,
+                        weights=weights, sigma=sigma)
 
     # ------------------------------------------------------------------ public
     def build_operators(self, data, frame_shape):
@@ -467,6 +475,26 @@ class DualGraphMOD:
         mu, basis = np.linalg.eigh(phi_t.toarray())
         return {'phi_s': phi_s, 'phi_t': phi_t.astype(np.float32).toarray(),
                 'basis': basis.astype(np.float32), 'mu': mu}
+
+    def objective(self, data, frame_shape):
+        """
+        Return the model's objective at the fitted ``L`` and ``S``.
+
+        ``||D - L - S||_1 + lambda1 ||L||_{W,*} + lambda2 ||S||_1 + g1/2 tr(L^T Phi_s L)
+        + g2/2 tr(L Phi_t L^T)`` in float64, with the weights taken from the
+        singular values of ``L`` itself (the fixed point of the reweighting),
+        so that solutions reached by different sweeps are scored alike.
+        """
+        data = self._validate(data, frame_shape)
+        L = self.background_.astype(np.float64)
+        S = self.foreground_.astype(np.float64)
+        ops = self.build_operators(data, frame_shape)
+        sigma = gram_eigh(L, vectors=False)
+        weights = np.exp(-(sigma / self.weight_scale_) ** 2)
+        return float(np.abs(data - L - S).sum() + self.lambda1_ * (weights * sigma).sum()
+                     + self.lambda2 * np.abs(S).sum()
+                     + 0.5 * self.gamma1 * (L * (ops['phi_s'] @ L)).sum()
+                     + 0.5 * self.gamma2 * (L * (L @ ops['phi_t'])).sum())
 
     def fit(self, data, frame_shape, init=None):
         """

@@ -5,12 +5,14 @@ Fused, multi-threaded kernels of one ADMM sweep of :class:`DualGraphMOD`.
 
 A sweep of the numpy formulation is about 25 single-threaded passes over
 ``n x m`` float32 arrays. Here it is one pass, threaded over blocks of pixel
-rows (:func:`primal_pass`): the previous sweep's dual updates and the sums of
-squares of its primal residuals, the gradient L-step (spatial and temporal
-Laplacians applied as diagonal bands), the S- and V-shrinkages, ``Lh = L - Y1``
-and the sums of squares behind the relative changes. :func:`dual_pass` does
-the dual updates alone, for the last sweep and for the L-steps computed in
-numpy (which need the updated duals first).
+rows (:func:`primal_pass`): the gradient L-step (spatial and temporal
+Laplacians applied as diagonal bands), the S- and V-shrinkages, the dual
+update of ``Y2``, the next SVT input ``Lh`` and the sums of squares behind the
+stopping rule. ``Y1`` is never stored (``Y1 = U - Lh`` after every U-step),
+and V, ``Y2`` and ``Lh`` are updated in place, so the pass moves as few
+arrays as the sweep needs (docs/solver.md, "Fused sweep").
+:func:`squared_gap` gives the primal residual ``||U - L||`` where the next
+pass cannot wait for it.
 
 Between passes the weighted SVT stays with BLAS: the Gram matrix ``Lh^T Lh``
 and the rank-k product ``U = (Lh left) right_t`` are dense products that a
@@ -87,20 +89,6 @@ def _shrink(x, t):
     return x - min(max(x, -t), t)
 
 
-@njit(cache=True, inline='always')
-def _dual_row(i, data, L, S, V, U, Y1, Y2, r_u, r_v):
-    # One row of Y1 += U - L, Y2 += D - L - S - V; the residuals' sums of
-    # squares go on from r_u, r_v (the callers' running block sums).
-    for j in range(data.shape[1]):
-        gap = U[i, j] - L[i, j]
-        Y1[i, j] += gap
-        r_u += gap * gap
-        residual = data[i, j] - L[i, j] - S[i, j] - V[i, j]
-        Y2[i, j] += residual
-        r_v += residual * residual
-    return r_u, r_v
-
-
 # Reassociation lets the compiler vectorise the sums of squares; no
 # 'nnan'/'ninf': the solver detects a non-finite iterate from those sums.
 # nogil: a pass takes milliseconds, and the node's image callback must not
@@ -109,21 +97,25 @@ _FAST = {'reassoc', 'contract', 'nsz'}
 
 
 @njit(parallel=True, cache=True, fastmath=_FAST, nogil=True)
-def primal_pass(data, L, U, Y1, S, V, Y2,
-                s_offsets, s_bands, t_offsets, t_bands, coefficients, l_given, dual_first,
-                L_new, S_new, V_new, Lh):
+def primal_pass(data, L, U, Lh, S, V, Y2,
+                s_offsets, s_bands, t_offsets, t_bands, coefficients, l_given,
+                L_new, S_new):
     """
-    Run steps 1, 2 and 4 of a sweep and form the SVT input, fused, threaded over row blocks.
+    Run one sweep but the SVT, fused, threaded over row blocks.
 
-    Writes ``L_new`` (one gradient step of the L-subproblem), ``S_new``,
-    ``V_new`` and ``Lh = L_new - Y1``. ``coefficients`` = (g1, g2, c, rho1,
-    rho2, step, lam2 / rho2, 1 / rho2) as float64. With ``l_given`` the L-step
-    is skipped and ``L_new`` is read as the caller computed it (the exact or
-    multi-step L-steps). With ``dual_first`` each row first takes the previous
-    sweep's dual updates (what :func:`dual_pass` does, with ``U`` that sweep's
-    SVT): one pass over the arrays instead of two. Returns the float64 sums
-    ``(||L_new - L||^2, ||L||^2, ||S_new - S||^2, ||S||^2, ||U - L||^2,
-    ||D - L - S - V||^2)``, the last two zero without ``dual_first``.
+    The dual ``Y1`` is not stored: after every U-step ``Y1 = U - Lh`` exactly
+    (``Y1 + U - L`` with ``Lh = L - Y1``), so each row reads it from ``U`` and
+    the previous ``Lh``. Per row: the L-step (one gradient step into
+    ``L_new``; with ``l_given`` the caller computed ``L_new`` in numpy), the
+    S-step into ``S_new``, and in place the V-step, ``Y2 += D - L - S - V``
+    and the next SVT input ``Lh = L_new - Y1``. ``L`` and ``S`` keep the
+    previous iterate (the L-step reads neighbouring rows of ``L``; the solver
+    falls back on both when an iterate is not finite). ``coefficients`` =
+    (g1, g2, c, rho1, rho2, step, lam2 / rho2, 1 / rho2) as float64.
+
+    Returns the float64 sums ``(||L_new - L||^2, ||L||^2, ||S_new - S||^2,
+    ||S||^2, ||U - L||^2, ||D - L_new - S_new - V_new||^2)``: the fifth is the
+    previous sweep's primal residual of ``U = L`` (``U`` is that sweep's SVT).
     """
     n, m = data.shape
     g1 = np.float32(coefficients[0])
@@ -142,6 +134,7 @@ def primal_pass(data, L, U, Y1, S, V, Y2,
     for b in prange(n_blocks):
         spatial = np.empty(m, dtype=np.float32)
         temporal = np.empty(m, dtype=np.float32)
+        dual = np.empty(m, dtype=np.float32)
         # One row of L with ``reach`` zeros either side: the temporal bands
         # become fixed-length loops (the bands are zero where j + off leaves
         # the window).
@@ -153,8 +146,10 @@ def primal_pass(data, L, U, Y1, S, V, Y2,
         r_u = 0.0
         r_v = 0.0
         for i in range(b * _BLOCK_ROWS, min(n, (b + 1) * _BLOCK_ROWS)):
-            if dual_first:      # row-local: the L-step below reads Y1, Y2 of row i only
-                r_u, r_v = _dual_row(i, data, L, S, V, U, Y1, Y2, r_u, r_v)
+            for j in range(m):
+                dual[j] = U[i, j] - Lh[i, j]
+                gap = U[i, j] - L[i, j]
+                r_u += gap * gap
             if not l_given:
                 for j in range(m):
                     spatial[j] = 0.0
@@ -175,7 +170,7 @@ def primal_pass(data, L, U, Y1, S, V, Y2,
                     for j in range(m):
                         temporal[j] += t_bands[k, j] * padded[start + np.uint64(j)]
                 for j in range(m):
-                    rhs = rho1 * (U[i, j] + Y1[i, j]) \
+                    rhs = rho1 * (U[i, j] + dual[j]) \
                         + rho2 * (data[i, j] - S[i, j] - V[i, j] + Y2[i, j])
                     grad = c * L[i, j] - rhs + g1 * spatial[j] + g2 * temporal[j]
                     L_new[i, j] = L[i, j] - step * grad
@@ -183,9 +178,13 @@ def primal_pass(data, L, U, Y1, S, V, Y2,
                 background = L_new[i, j]
                 residual = data[i, j] - background
                 foreground = _shrink(residual - V[i, j] + Y2[i, j], t_s)
+                noise = _shrink(residual - foreground + Y2[i, j], t_v)
+                gap = residual - foreground - noise
+                Y2[i, j] += gap
+                r_v += gap * gap
                 S_new[i, j] = foreground
-                V_new[i, j] = _shrink(residual - foreground + Y2[i, j], t_v)
-                Lh[i, j] = background - Y1[i, j]
+                V[i, j] = noise
+                Lh[i, j] = background - dual[j]
                 delta = background - L[i, j]
                 d_l += delta * delta
                 n_l += L[i, j] * L[i, j]
@@ -202,23 +201,19 @@ def primal_pass(data, L, U, Y1, S, V, Y2,
 
 
 @njit(parallel=True, cache=True, fastmath=_FAST, nogil=True)
-def dual_pass(data, L, S, V, U, Y1, Y2):
-    """
-    Update the duals ``Y1 += U - L``, ``Y2 += D - L - S - V`` in one threaded pass.
-
-    Returns the float64 sums ``(||U - L||^2, ||D - L - S - V||^2)``.
-    """
-    n = data.shape[0]
+def squared_gap(a, b):
+    """Return ``||a - b||_F^2`` in float64, threaded over row blocks."""
+    n = a.shape[0]
     n_blocks = (n + _BLOCK_ROWS - 1) // _BLOCK_ROWS
-    sums = np.zeros((n_blocks, 2), dtype=np.float64)
-    for b in prange(n_blocks):
-        r_u = 0.0
-        r_v = 0.0
-        for i in range(b * _BLOCK_ROWS, min(n, (b + 1) * _BLOCK_ROWS)):
-            r_u, r_v = _dual_row(i, data, L, S, V, U, Y1, Y2, r_u, r_v)
-        sums[b, 0] = r_u
-        sums[b, 1] = r_v
-    return sums.sum(axis=0)
+    sums = np.zeros(n_blocks, dtype=np.float64)
+    for blk in prange(n_blocks):
+        total = 0.0
+        for i in range(blk * _BLOCK_ROWS, min(n, (blk + 1) * _BLOCK_ROWS)):
+            for j in range(a.shape[1]):
+                gap = a[i, j] - b[i, j]
+                total += gap * gap
+        sums[blk] = total
+    return sums.sum()
 
 
 def compile_all():
