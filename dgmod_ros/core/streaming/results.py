@@ -99,8 +99,9 @@ class BackgroundModel:
         The newest background column as an image at the processing size.
     mean_background : ndarray (rows, cols, C)
         The window's mean background (the paper's background estimate).
-    threshold : float
-        Mask threshold estimated from this window's residual.
+    threshold : float or None
+        Mask threshold estimated from this window's residual (the global
+        rule); None when solved for a per-pixel decision, which reads ``noise``.
     shape : tuple
         (rows, cols, C) processing shape the model belongs to.
     first_id, last_id : int

@@ -256,6 +256,8 @@ class SlidingWindowDetector(StreamingDetector):
             return background, warmup_noise(buffered)
         background = robust_projection(model.basis, columns)
         if self.decision == 'global':
+            if model.threshold is None:     # solved for a per-pixel decision (switched since)
+                return background, self.mask_rule_.threshold_from_noise(model.noise)
             return background, model.threshold
         if model.noise is None:             # solved under the global rule
             return background, model.threshold / self.mask_rule_.k
