@@ -51,6 +51,9 @@ def check_window_parameters(detector):
     size = detector.median_size
     if int(size) != size or size < 1 or size % 2 == 0:
         raise ValueError(f'median_size must be an odd positive integer, got {size!r}')
+    lag = detector.solve_lag
+    if int(lag) != lag or not 0 <= lag <= stride:
+        raise ValueError(f'solve_lag must be an integer in [0, stride={stride}], got {lag!r}')
     (detector.mask_rule or MaskRule()).validate()
 
 

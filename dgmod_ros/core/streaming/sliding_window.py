@@ -113,6 +113,13 @@ class SlidingWindowDetector(StreamingDetector):
         than of the frame (something in the window's frames has left; see
         :func:`~dgmod_ros.core.streaming.foreground.ghost_blobs`); their
         pixels enter the window as they are, which heals the background.
+    solve_lag : int, default=0
+        Frames between a solve's snapshot and its install (at most
+        ``stride``): the solve of the window taken at frame ``t`` becomes the
+        model right before frame ``t + solve_lag`` is masked, so it may run
+        beside ``solve_lag`` frames of per-frame work with the same masks
+        whatever its speed (the install rule of
+        :class:`~dgmod_ros.core.streaming.contract.StreamingDetector`).
 
     Attributes
     ----------
@@ -132,7 +139,7 @@ class SlidingWindowDetector(StreamingDetector):
                  mask_rule=None, motion_threshold=0.0, min_frames=5, basis_rank=2,
                  global_change_fraction=0.7, memory_spacing=10, conditional_update=True,
                  absorb_frames=300, decision='adaptive', pixel_k=6.0, median_size=5,
-                 ghost_test=True):
+                 ghost_test=True, solve_lag=0):
         self.model = model
         self.window = window
         self.stride = stride
@@ -150,6 +157,7 @@ class SlidingWindowDetector(StreamingDetector):
         self.pixel_k = pixel_k
         self.median_size = median_size
         self.ghost_test = ghost_test
+        self.solve_lag = solve_lag
         self._validated = False
 
     # ------------------------------------------------------------- set-up
@@ -345,6 +353,8 @@ class SlidingWindowDetector(StreamingDetector):
     def solve_due(self):
         """Tell whether a window solve should run now."""
         self._ensure_started()
+        if self.solve_in_flight():
+            return False
         if self.background_model_ is None:
             return len(self.buffer_) >= self.min_frames
         return self.since_solve_ >= self.stride
