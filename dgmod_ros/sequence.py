@@ -22,15 +22,14 @@ def stream_results(frames, values):
     ``background`` (float [0, 1], input size, (h, w, C)) is given where the
     detector announces a new one (the node publishes it there), ``window`` (a
     dict with ``seconds`` and ``iterations``) where a window was solved; both
-    are None elsewhere. With ``solve_lag`` > 0 each solve runs in a worker
-    thread beside the next ``solve_lag`` frames; the install rule of the
-    streaming contract makes the masks those of solving in line (the node's
-    sync mode).
+    are None elsewhere. The solves run in a worker thread beside the per-frame
+    work (started as soon as their window is final, installed ``solve_lag``
+    frames after they are due); the install rule of the streaming contract
+    makes the masks those of solving in line (the node's sync mode).
     """
     detector = config.build_detector(values)
     value_range = values['value_range'] or None
-    with ThreadPoolExecutor(max_workers=1, thread_name_prefix='dgmod-solve') as pool:
-        executor = pool if values['solve_lag'] > 0 else None
+    with ThreadPoolExecutor(max_workers=1, thread_name_prefix='dgmod-solve') as executor:
         for frame in frames:
             result, solved = detector.process(frame.image, frame.channel_order, value_range,
                                               executor=executor)

@@ -19,7 +19,11 @@ the solve of a snapshot taken at frame ``t`` right before masking frame
 for detectors without it), whether the solve ran in line or in another thread
 (``executor``): if it is not finished by then, ``process`` waits for it. The
 masks therefore never depend on how fast a solve runs, and a solve has
-``solve_lag`` frames of time to run beside the per-frame work.
+``solve_lag`` frames of time to run beside the per-frame work. With an
+executor, a solve whose window is already final before it is due (no frame
+will be admitted in between, :meth:`~StreamingDetector.frames_until_final_solve`)
+starts at once and is installed at the frame it would have been: more time
+beside the per-frame work, the same masks.
 :meth:`~StreamingDetector.push` keeps the same rule without waiting: a solve
 finished late is installed at the first frame after it finished.
 
@@ -130,8 +134,9 @@ class StreamingDetector(ABC):
         """
         pending = self._ingest(frame, channel_order, value_range)
         installed, error = self._install_finished(wait=True)
-        if self.solve_due():
-            snapshot = self.snapshot()
+        ahead = 0 if executor is None or self.solve_due() else self.frames_until_final_solve()
+        if self.solve_due() or ahead:
+            snapshot = self.snapshot(ahead)
             if executor is None:
                 future = Future()
                 try:
@@ -140,7 +145,7 @@ class StreamingDetector(ABC):
                     future.set_exception(failure)
             else:
                 future = executor.submit(self.solve, snapshot)
-            self.track_solve(snapshot, future)
+            self.track_solve(snapshot, future, ahead)
             if self.solve_in_flight_.frames_left <= 0:
                 installed, error = self._install_finished(wait=True, count=False)
         result = self._finish(pending)
@@ -148,16 +153,32 @@ class StreamingDetector(ABC):
         return result, installed
 
     # ------------------------------------------------------------- install rule
-    def track_solve(self, snapshot, future):
+    def frames_until_final_solve(self):
         """
-        Register the solve of ``snapshot``, running in ``future``, for the lag rule.
+        Return in how many frames the next solve is due if its window is already final, else 0.
+
+        A positive answer lets :meth:`process` start that solve now, in its
+        executor: the snapshot taken now equals the one it would take then
+        (no frame is admitted in between), so the solve is the same and
+        is installed at the same frame. Detectors without window solves
+        answer 0.
+        """
+        return 0
+
+    def track_solve(self, snapshot, future, ahead=0):
+        """
+        Register the solve of ``snapshot``, running in ``future``, for the install rule.
 
         The next :meth:`push` or :meth:`process` calls count frames against
         it and install its model (or report its :class:`SolverFailure`) once
-        ``solve_lag`` frames have passed. One solve is in flight at a time.
+        ``ahead + solve_lag`` frames have passed (``ahead``: the frames by
+        which an early start precedes the frame the solve is due). The first
+        solve (no model yet: masks come from the warm-up) is installed without
+        lag. One solve is in flight at a time.
         """
+        lag = int(getattr(self, 'solve_lag', 0)) if snapshot.previous is not None else 0
         self.solve_in_flight_ = SolveInFlight(ticket=snapshot.ticket, future=future,
-                                              frames_left=int(getattr(self, 'solve_lag', 0)))
+                                              frames_left=int(ahead) + lag)
 
     def solve_in_flight(self):
         """Tell whether a started solve waits to be installed (no new solve is due till then)."""
@@ -206,8 +227,13 @@ class StreamingDetector(ABC):
         """Tell whether a window solve should run now."""
 
     @abstractmethod
-    def snapshot(self):
-        """Copy what the due solve needs (a WindowSnapshot with the current ticket)."""
+    def snapshot(self, ahead=0):
+        """
+        Copy what the due solve needs (a WindowSnapshot with the current ticket).
+
+        ``ahead`` (from :meth:`frames_until_final_solve`) takes the snapshot of
+        a solve due that many frames later; the stride count restarts there.
+        """
 
     @abstractmethod
     def solve(self, snapshot):

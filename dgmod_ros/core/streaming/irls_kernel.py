@@ -49,6 +49,22 @@ def _rank2_equations(basis, columns, coef, floor, gram, rhs):
 
 
 @njit(cache=True, nogil=True, fastmath=_FAST)
+def _rank1_equations(basis, columns, coef, floor, gram, rhs):
+    # A still scene's background has rank 1.
+    for c in range(basis.shape[0]):
+        c0 = np.float32(coef[c, 0])
+        g00 = r0 = 0.0
+        for i in range(basis.shape[1]):
+            b0 = basis[c, i, 0]
+            d = columns[c, i]
+            w0 = b0 / max(abs(d - b0 * c0), np.float32(floor))
+            g00 += w0 * b0
+            r0 += w0 * d
+        gram[c, 0, 0] = g00
+        rhs[c, 0] = r0
+
+
+@njit(cache=True, nogil=True, fastmath=_FAST)
 def _any_rank_equations(basis, columns, coef, floor, gram, rhs):
     channels, n, rank = basis.shape
     for c in range(channels):
@@ -94,13 +110,13 @@ def weighted_normal_equations(basis, columns, coef, floor, gram, rhs):
         Output.
 
     """
-    kernel = _rank2_equations if basis.shape[2] == 2 else _any_rank_equations
+    kernel = {1: _rank1_equations, 2: _rank2_equations}.get(basis.shape[2], _any_rank_equations)
     kernel(basis, columns, coef, floor, gram, rhs)
 
 
 def compile_kernel():
     """Compile (or load from the cache) both passes on a tiny input."""
-    for rank in (1, 2):
+    for rank in (1, 2, 3):
         weighted_normal_equations(np.ones((1, 4, rank), dtype=np.float32),
                                   np.ones((1, 4), dtype=np.float32), np.zeros((1, rank)),
                                   1e-3, np.empty((1, rank, rank)), np.empty((1, rank)))

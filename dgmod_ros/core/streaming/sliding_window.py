@@ -359,13 +359,35 @@ class SlidingWindowDetector(StreamingDetector):
             return len(self.buffer_) >= self.min_frames
         return self.since_solve_ >= self.stride
 
-    def snapshot(self):
-        """Copy the window for a solve and restart the stride count."""
+    def frames_until_final_solve(self):
+        """
+        Return in how many frames the next solve is due if no frame is admitted till then, else 0.
+
+        Only with a model and a full window: admissions then come every
+        ``memory_spacing`` frames at the earliest, so the window of the
+        next solve is known as soon as the last admission before it is in.
+        """
+        self._ensure_started()
+        if (self.solve_in_flight() or self.background_model_ is None
+                or len(self.buffer_) < self.buffer_.capacity
+                or self.buffer_.last_admitted_id is None):
+            return 0
+        ahead = int(self.stride) - self.since_solve_
+        # This frame's id; admissions happen when frames are masked (_finish).
+        frame_id = self.next_id_ - 1
+        next_admission = self.buffer_.last_admitted_id + self.buffer_.spacing
+        return ahead if 0 < ahead and frame_id + ahead <= next_admission else 0
+
+    def snapshot(self, ahead=0):
+        """Copy the window for a solve and restart the stride count (``ahead`` frames later)."""
         self._ensure_started()
         if len(self.buffer_) < 2:
             raise ValueError('a window solve needs at least 2 buffered frames')
         data = self.buffer_.stack()                            # (C, n, m)
-        self.since_solve_ = 0
+        # An early start restarts the count at the frame the solve is due;
+        # if it is discarded, the frames it took back are given back.
+        self.early_credit_ = self.since_solve_ + int(ahead) if ahead else 0
+        self.since_solve_ = -int(ahead)
         return WindowSnapshot(data=data, shape=self.shape_, first_id=self.buffer_.first_id,
                               last_id=self.buffer_.last_id, previous=self.background_model_,
                               model=self.model_, mask_rule=self.mask_rule_,
@@ -382,6 +404,12 @@ class SlidingWindowDetector(StreamingDetector):
         with another concurrent solve).
         """
         return solve_window(snapshot)
+
+    def _new_generation(self):
+        if self.solve_in_flight() and getattr(self, 'early_credit_', 0):
+            self.since_solve_ += self.early_credit_    # the early solve is due as before
+        self.early_credit_ = 0
+        super()._new_generation()
 
     def drop_warm_start(self):
         """Make the next solve start cold (after a failed one), keeping the fast path."""
