@@ -13,11 +13,15 @@ output that looks finished.
 """
 
 import argparse
+from collections import deque
+from concurrent.futures import ThreadPoolExecutor
 import io
 import json
 from pathlib import Path
+import queue
 import shutil
 import sys
+import threading
 import time
 
 import cv2
@@ -156,6 +160,76 @@ def _write_png(path, image):
         raise OSError(f'cannot write {path}')
 
 
+# Frames read ahead and PNG files waiting to be written: a few frames of
+# slack, so that decoding and encoding (OpenCV, without the GIL) overlap the
+# separation without holding a sequence in memory.
+_READ_AHEAD = 8
+_WRITES_PENDING = 16
+
+
+def read_ahead(iterable, depth=_READ_AHEAD):
+    """
+    Yield the items of ``iterable`` in order, produced ``depth`` ahead in a thread.
+
+    An exception raised by ``iterable`` is raised here at its place in the
+    order. Closing the generator stops the thread.
+    """
+    items = queue.Queue(maxsize=depth)
+    stop = threading.Event()
+    end = object()
+
+    def produce():
+        try:
+            for item in iterable:
+                while not stop.is_set():
+                    try:
+                        items.put((item, None), timeout=0.1)
+                        break
+                    except queue.Full:
+                        continue
+                if stop.is_set():
+                    return
+            items.put((end, None))
+        except BaseException as error:  # noqa: B902 - handed to the consumer
+            items.put((end, error))
+
+    thread = threading.Thread(target=produce, name='dgmod-read', daemon=True)
+    thread.start()
+    try:
+        while True:
+            item, error = items.get()
+            if error is not None:
+                raise error
+            if item is end:
+                return
+            yield item
+    finally:
+        stop.set()
+        thread.join()
+
+
+class PngWriter:
+    """Write PNG files in a thread, at most ``_WRITES_PENDING`` waiting; errors raised here."""
+
+    def __init__(self):
+        self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix='dgmod-write')
+        self._pending = deque()
+
+    def write(self, path, image):
+        """Queue one file (``image`` must not change afterwards)."""
+        self._pending.append(self._pool.submit(_write_png, path, image))
+        while len(self._pending) > _WRITES_PENDING:
+            self._pending.popleft().result()
+
+    def close(self):
+        """Wait for every queued file; raise the first error."""
+        try:
+            while self._pending:
+                self._pending.popleft().result()
+        finally:
+            self._pool.shutdown(wait=True, cancel_futures=True)
+
+
 def _background_png(background):
     pixels = to_uint8(background)
     if pixels.ndim == 3 and pixels.shape[2] == 1:
@@ -178,16 +252,22 @@ def separate(args):
                         stream=io.StringIO() if args.quiet else sys.stderr)
     started = time.perf_counter()
     windows = []
+    writer = PngWriter()
     try:
-        frames = _good_frames(read_frames(args.input, args.topic), args.skip_bad, skipped)
-        for frame, mask, background, window in results(frames, values, args.mode):
-            _write_png(partial / 'masks' / f'{frame.stem}.png', mask)
-            if background is not None:
-                _write_png(partial / 'background' / f'{frame.stem}.png',
-                           _background_png(background))
-            if window is not None:
-                windows.append(window)
-            progress.step()
+        frames = read_ahead(_good_frames(read_frames(args.input, args.topic), args.skip_bad,
+                                         skipped))
+        try:
+            for frame, mask, background, window in results(frames, values, args.mode):
+                writer.write(partial / 'masks' / f'{frame.stem}.png', mask)
+                if background is not None:
+                    writer.write(partial / 'background' / f'{frame.stem}.png',
+                                 _background_png(background))
+                if window is not None:
+                    windows.append(window)
+                progress.step()
+        finally:
+            frames.close()
+            writer.close()
     except BaseException:
         shutil.rmtree(partial, ignore_errors=True)
         raise

@@ -99,6 +99,10 @@ PARAMETERS = (
               1e-8, 0.1),
     Parameter('max_iter', 300, 'ADMM sweeps per window solve at most (T_out) in batch mode',
               1, 10000),
+    Parameter('solve_lag', 0, 'frames between the window snapshot of a solve and its install '
+              '(<= stride): the solve runs beside that many frames of per-frame work, and the '
+              'masks do not depend on its speed (sync mode and offline; async installs late '
+              'solves at the first frame after they end)', 0, 300),
     Parameter('stream_max_iter', 5, 'ADMM sweeps per window solve while streaming (node, '
               'stream mode): each solve starts from the last, so sweeps add up over '
               'overlapping windows', 1, 10000),
@@ -239,7 +243,7 @@ def detector_settings(values):
             'absorb_frames': values['absorb_frames'], 'decision': values['decision'],
             'pixel_k': values['pixel_k'], 'median_size': values['median_size'],
             'ghost_test': values['ghost_test'], 'still_frames': values['still_frames'],
-            'mrf_beta': values['mrf_beta']}
+            'mrf_beta': values['mrf_beta'], 'solve_lag': values['solve_lag']}
 
 
 def validate(values):

@@ -240,7 +240,9 @@ class DetectorNode(LifecycleNode):
                 if self._values['solve_mode'] == 'sync':
                     result, solved = detector.process(image, order or 'rgb', value_range)
                 else:
-                    result, solved = detector.push(image, order or 'rgb', value_range), None
+                    # A solve left in flight by the sync mode is installed here.
+                    result = detector.push(image, order or 'rgb', value_range)
+                    solved = result.installed
                     if detector.solve_due():
                         self._stats.solve_due()
                         if not self._worker.busy:

@@ -2,6 +2,8 @@
 # Licensed under the Apache License, Version 2.0
 """Run one method over a sequence of frames, in stream or batch mode (no ROS import)."""
 
+from concurrent.futures import ThreadPoolExecutor
+
 import cv2
 
 from . import config
@@ -20,19 +22,24 @@ def stream_results(frames, values):
     ``background`` (float [0, 1], input size, (h, w, C)) is given where the
     detector announces a new one (the node publishes it there), ``window`` (a
     dict with ``seconds`` and ``iterations``) where a window was solved; both
-    are None elsewhere.
+    are None elsewhere. The solves run in a worker thread beside the per-frame
+    work (started as soon as their window is final, installed ``solve_lag``
+    frames after they are due); the install rule of the streaming contract
+    makes the masks those of solving in line (the node's sync mode).
     """
     detector = config.build_detector(values)
     value_range = values['value_range'] or None
-    for frame in frames:
-        result, solved = detector.process(frame.image, frame.channel_order, value_range)
-        window = None
-        if solved is not None:
-            window = {'first_frame': solved.first_id, 'last_frame': solved.last_id,
-                      'seconds': solved.seconds, 'iterations': solved.iterations,
-                      'info': solved.info}
-        background = detector.background_image() if result.new_background else None
-        yield frame, result.mask, background, window
+    with ThreadPoolExecutor(max_workers=1, thread_name_prefix='dgmod-solve') as executor:
+        for frame in frames:
+            result, solved = detector.process(frame.image, frame.channel_order, value_range,
+                                              executor=executor)
+            window = None
+            if solved is not None:
+                window = {'first_frame': solved.first_id, 'last_frame': solved.last_id,
+                          'seconds': solved.seconds, 'iterations': solved.iterations,
+                          'info': solved.info}
+            background = detector.background_image() if result.new_background else None
+            yield frame, result.mask, background, window
 
 
 def batch_results(frames, values):

@@ -1,6 +1,7 @@
 # Copyright 2026 dgmod_ros authors
 # Licensed under the Apache License, Version 2.0
-from dgmod_ros.core.graphs import spatial_laplacian, temporal_laplacian
+from dgmod_ros.core.graphs import (banded_matrix, spatial_laplacian, spatial_laplacian_bands,
+                                   temporal_laplacian)
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -93,3 +94,48 @@ def test_smoothing_changes_weights_but_not_structure(window):
     smooth, _ = spatial_laplacian(data, shape, smoothing_sigma=1.0)
     assert plain.nnz == smooth.nnz
     assert not np.allclose(plain.toarray(), smooth.toarray())
+
+
+def _laplacian_from_definition(data, shape, patch_size):
+    """Dense ``I - W^-1/2 A W^-1/2`` with patch distances summed pixel by pixel (small images)."""
+    n1, n2 = shape
+    cube = data.reshape(n1, n2, -1).astype(np.float64)
+    half = patch_size // 2
+    padded = np.pad(cube, ((half + 1, half + 1), (half + 1, half + 1), (0, 0)), mode='reflect')
+    edges, dists = [], []
+    for r in range(n1):
+        for c in range(n2):
+            for dr, dc in ((0, 1), (1, 0)):
+                if r + dr >= n1 or c + dc >= n2:
+                    continue
+                rows = slice(r + 1, r + 1 + patch_size)
+                cols = slice(c + 1, c + 1 + patch_size)
+                here = padded[rows, cols]
+                there = padded[r + dr + 1:r + dr + 1 + patch_size,
+                               c + dc + 1:c + dc + 1 + patch_size]
+                edges.append((r * n2 + c, (r + dr) * n2 + c + dc))
+                dists.append(np.sum((here - there) ** 2))
+    h2 = np.median(dists)
+    adjacency = np.zeros((n1 * n2,) * 2)
+    for (i, j), dist in zip(edges, dists):
+        adjacency[i, j] = adjacency[j, i] = np.exp(-dist / h2)
+    scale = 1 / np.sqrt(adjacency.sum(axis=1))
+    return np.eye(n1 * n2) - scale[:, None] * adjacency * scale[None, :]
+
+
+@pytest.mark.parametrize('shape', [(12, 9), (1, 9), (9, 1), (2, 2)])
+def test_spatial_bands_are_the_laplacian_of_the_definition(shape):
+    rng = np.random.default_rng(5)
+    data = rng.random((shape[0] * shape[1], 6)).astype(np.float32)
+    # Patch size 1: the definition's reflected border and the box filter's agree.
+    offsets, bands, _ = spatial_laplacian_bands(data, shape, patch_size=1)
+    expected = _laplacian_from_definition(data, shape, 1)
+    assert np.allclose(banded_matrix(offsets, bands).toarray(), expected, atol=1e-6)
+    assert np.array_equal(offsets, np.unique(offsets))
+    n = shape[0] * shape[1]
+    for offset, band in zip(offsets, bands):
+        rows = np.arange(n)
+        inside = (rows + offset >= 0) & (rows + offset < n)
+        assert np.all(band[~inside] == 0)
+        assert np.allclose(band[inside], expected[rows[inside], rows[inside] + offset],
+                           atol=1e-6)

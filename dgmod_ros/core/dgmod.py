@@ -6,7 +6,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .graphs import spatial_laplacian, temporal_laplacian
+from .graphs import banded_matrix, spatial_laplacian_bands, temporal_laplacian
 from .linalg import (drop_oldest, gram_eigh, mixing_factors, relative_change, shrink,
                      singular_value_map, top_singular_value)
 from .runtime import limit_blas_threads
@@ -400,7 +400,7 @@ class DualGraphMOD:
         g1, g2, c = float(self.gamma1), float(self.gamma2), rho1 + rho2
         step = self.step_size or 1.0 / (2.0 * g1 + 2.0 * g2 + c)
         coefficients = np.array([g1, g2, c, rho1, rho2, step, self.lambda2 / rho2, 1.0 / rho2])
-        s_offsets, s_bands = kernels.diagonal_bands(ops['phi_s'])
+        s_offsets, s_bands = ops['phi_s_bands']
         # The kernel reads Phi_t[j, j + off]; Phi_t is symmetric, so its own bands serve.
         t_offsets, t_bands = kernels.diagonal_bands(ops['phi_t'])
         # Other L-steps than one gradient step run in numpy and hand L_new over.
@@ -468,13 +468,19 @@ class DualGraphMOD:
 
     # ------------------------------------------------------------------ public
     def build_operators(self, data, frame_shape):
-        """Graph Laplacians and the temporal eigenbasis for one window."""
-        phi_s, self.h_s_ = spatial_laplacian(data, frame_shape, self.patch_size, self.h_s,
-                                             self.smoothing_sigma)
+        """
+        Graph Laplacians and the temporal eigenbasis for one window.
+
+        ``phi_s_bands`` holds the spatial Laplacian's diagonal bands (what the
+        fused sweep applies); the sparse ``phi_s`` of the numpy steps is formed
+        from them on first use only.
+        """
+        offsets, bands, self.h_s_ = spatial_laplacian_bands(
+            data, frame_shape, self.patch_size, self.h_s, self.smoothing_sigma)
         phi_t, self.h_t_ = temporal_laplacian(data, self.temporal_neighbors, self.h_t)
         mu, basis = np.linalg.eigh(phi_t.toarray())
-        return {'phi_s': phi_s, 'phi_t': phi_t.astype(np.float32).toarray(),
-                'basis': basis.astype(np.float32), 'mu': mu}
+        return _Operators(phi_s_bands=(offsets, bands), phi_t=phi_t.astype(np.float32).toarray(),
+                          basis=basis.astype(np.float32), mu=mu)
 
     def objective(self, data, frame_shape):
         """
@@ -556,6 +562,16 @@ class DualGraphMOD:
         self.background_ = L
         self.foreground_ = S
         return self
+
+
+class _Operators(dict):
+    """A window's operators; the sparse ``phi_s`` is formed from its bands when first read."""
+
+    def __missing__(self, key):
+        if key != 'phi_s':
+            raise KeyError(key)
+        self['phi_s'] = banded_matrix(*self['phi_s_bands'])
+        return self['phi_s']
 
 
 def _ratio(squared_change, squared_norm):

@@ -85,16 +85,20 @@ def _box_sum(image, patch_size):
                          borderType=cv2.BORDER_REFLECT)
 
 
-def spatial_laplacian(data, frame_shape, patch_size=3, h=None, smoothing_sigma=0.0):
+def spatial_laplacian_bands(data, frame_shape, patch_size=3, h=None, smoothing_sigma=0.0):
     """
-    Laplacian ``Phi_s`` (n x n, sparse) of the 4-neighbour pixel graph.
+    Diagonal bands of the Laplacian ``Phi_s`` of the 4-neighbour pixel graph.
 
     The weight of the edge between pixels i and j is
     ``exp(-||P_i - P_j||_F^2 / h_s^2)`` where ``P_i`` is the ``p x p`` patch
     around pixel i across all frames of the window. The squared patch distance
     of every horizontal (vertical) neighbour pair is a ``p x p`` box sum of the
     per-pixel squared differences summed over frames, so no loop over pixels
-    is needed.
+    is needed. In row-major pixel order the graph's Laplacian has the bands
+    0, +-1 and +-n2, computed here from the edge weights directly: the fused
+    solver applies the bands, and a sparse matrix of n x n with its index
+    arrays cost more than the weights themselves (``docs/solver.md``,
+    "Streaming").
 
     Parameters
     ----------
@@ -112,37 +116,97 @@ def spatial_laplacian(data, frame_shape, patch_size=3, h=None, smoothing_sigma=0
 
     Returns
     -------
-    laplacian : scipy.sparse.csr_matrix (n, n), float32
-    h : float, the filtering parameter used.
+    offsets : ndarray (k,) int64
+        Ascending band offsets.
+    bands : ndarray (k, n) float32
+        ``Phi_s[i, i + offsets[k]] == bands[k, i]``, zero where ``i + offset``
+        leaves the matrix or no edge joins the two pixels.
+    h : float
+        The filtering parameter used.
 
     """
     n1, n2 = frame_shape
     m = data.shape[1]
+    n = n1 * n2
     cube = np.asarray(data, dtype=np.float32).reshape(n1, n2, m)
     if smoothing_sigma > 0:
         cube = ndimage.gaussian_filter(cube, sigma=(smoothing_sigma, smoothing_sigma, 0),
                                        mode='reflect')
-    index = np.arange(n1 * n2).reshape(n1, n2)
-    rows, cols, dists = [], [], []
-    for axis in (1, 0):
-        if cube.shape[axis] < 2:
-            continue
+    # (axis, offset in row-major order) of the right and the lower neighbour.
+    directions = [(axis, step) for axis, step in ((1, 1), (0, n2)) if cube.shape[axis] >= 2]
+    if not directions:
+        return (np.zeros(1, dtype=np.int64), np.zeros((1, n), dtype=np.float32),
+                1.0 if h is None else float(h))
+    dists = []
+    for axis, _ in directions:
         lead = [slice(None)] * 2
         lag = [slice(None)] * 2
         lead[axis] = slice(1, None)
         lag[axis] = slice(None, -1)
         diff = cube[tuple(lead)] - cube[tuple(lag)]
         pixel_sq = np.einsum('ijk,ijk->ij', diff, diff)
-        dists.append(_box_sum(pixel_sq, patch_size).ravel())
-        rows.append(index[tuple(lag)].ravel())
-        cols.append(index[tuple(lead)].ravel())
-    n = n1 * n2
-    if not rows:
-        return sp.csr_matrix((n, n), dtype=np.float32), 1.0 if h is None else float(h)
-    rows = np.concatenate(rows)
-    cols = np.concatenate(cols)
-    weights, h_used = _gaussian_weights(np.concatenate(dists).astype(np.float64), h)
+        dists.append(_box_sum(pixel_sq, patch_size))
+    weights, h_used = _gaussian_weights(
+        np.concatenate([d.ravel() for d in dists]).astype(np.float64), h)
     weights = weights.astype(np.float32)
-    adjacency = sp.coo_matrix((np.r_[weights, weights], (np.r_[rows, cols], np.r_[cols, rows])),
-                              shape=(n, n))
-    return normalized_laplacian(adjacency), h_used
+    # Edge weight images: forward[axis][r, c] joins (r, c) to its next pixel
+    # along axis (zero at the last row or column).
+    forward = {}
+    start = 0
+    for (axis, _), dist in zip(directions, dists):
+        image = np.zeros((n1, n2), dtype=np.float32)
+        image[:n1 - (axis == 0), :n2 - (axis == 1)] = (
+            weights[start:start + dist.size].reshape(dist.shape))
+        forward[axis] = image
+        start += dist.size
+    # Each pixel's degree, summed in the order of the sparse row sum of
+    # before (right, down, left, up): the same float32 sums.
+    zero = np.zeros((n1, n2), dtype=np.float32)
+    lower, right = forward.get(0, zero), forward.get(1, zero)
+    degree = right + lower
+    degree += np.roll(right, 1, axis=1)
+    degree += np.roll(lower, 1, axis=0)
+    inv_sqrt = np.zeros_like(degree)
+    np.divide(1.0, np.sqrt(degree), out=inv_sqrt, where=degree > 0)
+    bands = {0: (degree > 0).astype(np.float32).ravel()}
+    for axis, step in directions:
+        # Phi_s[i, j] = -(w_ij / sqrt(d_i)) / sqrt(d_j) for the edge to the next
+        # pixel (j = i + step) and to the previous one (j = i - step), each
+        # product in the sparse product's order: bit for bit the same matrix.
+        for shift in (-1, 1):
+            weight = forward[axis] if shift == -1 else np.roll(forward[axis], 1, axis=axis)
+            coupling = -((inv_sqrt * weight) * np.roll(inv_sqrt, shift, axis=axis))
+            bands[-shift * step] = coupling.ravel()
+    offsets = np.array(sorted(bands), dtype=np.int64)
+    return offsets, np.stack([bands[o] for o in offsets]), h_used
+
+
+def banded_matrix(offsets, bands):
+    """Return the sparse CSR matrix with ``matrix[i, i + offsets[k]] == bands[k, i]``."""
+    n = bands.shape[1]
+    rows, cols, values = [], [], []
+    for offset, band in zip(offsets, bands):
+        row = np.arange(max(0, -offset), min(n, n - offset))
+        row = row[band[row] != 0]
+        rows.append(row)
+        cols.append(row + offset)
+        values.append(band[row])
+    return sp.csr_matrix((np.concatenate(values), (np.concatenate(rows), np.concatenate(cols))),
+                         shape=(n, n), dtype=bands.dtype)
+
+
+def spatial_laplacian(data, frame_shape, patch_size=3, h=None, smoothing_sigma=0.0):
+    """
+    Laplacian ``Phi_s`` (n x n, sparse) of the 4-neighbour pixel graph.
+
+    The matrix of :func:`spatial_laplacian_bands` (same parameters).
+
+    Returns
+    -------
+    laplacian : scipy.sparse.csr_matrix (n, n), float32
+    h : float, the filtering parameter used.
+
+    """
+    offsets, bands, h_used = spatial_laplacian_bands(data, frame_shape, patch_size, h,
+                                                     smoothing_sigma)
+    return banded_matrix(offsets, bands), h_used

@@ -228,3 +228,5 @@ def compile_all():
     data = np.linspace(0.0, 1.0, 12 * 4, dtype=np.float32).reshape(12, 4)
     DualGraphMOD(max_iter=1).fit(data, (3, 4))
     DualGraphMOD(max_iter=1, l_step='exact').fit(data, (3, 4))
+    from .streaming.irls_kernel import compile_kernel     # the fast path's projection
+    compile_kernel()

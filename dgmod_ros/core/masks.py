@@ -104,6 +104,17 @@ class MaskRule:
             sigma = min(sigma, robust_sigma(np.diff(frames, axis=-1)) / np.sqrt(2.0))
         return max(float(self.min_threshold), self.k * sigma)
 
+    def threshold_from_noise(self, noise):
+        """
+        Return ``tau`` from per-pixel noise levels (a model solved for a per-pixel decision).
+
+        ``k`` times the median level, at least ``min_threshold``; a fixed
+        threshold is returned as it is.
+        """
+        if not isinstance(self.threshold, str):
+            return float(self.threshold)
+        return max(float(self.min_threshold), self.k * float(np.median(noise)))
+
     def apply(self, magnitude, threshold, output_shape=None):
         """
         Binary mask (uint8, 0 or 255) of one frame's foreground magnitude.

@@ -67,19 +67,20 @@ def separate_channels(model, data, frame_shape, inits=None):
     """
     started = time.perf_counter()
     inits = inits if inits is not None else [None] * data.shape[0]
-    backgrounds, foregrounds, residuals, states = [], [], [], []
+    backgrounds, foregrounds, states = [], [], []
+    residuals = np.empty(data.shape, dtype=np.float32)
     iterations, info, diverged = 0, 0, False
     for channel, init in enumerate(inits):
         fitted = model.fit(data[channel], frame_shape, init=init)
         background = np.asarray(fitted.background_, dtype=np.float32)
         backgrounds.append(background)
         foregrounds.append(np.asarray(fitted.foreground_, dtype=np.float32))
-        residuals.append(data[channel] - background)
+        np.subtract(data[channel], background, out=residuals[channel])
         states.append(getattr(fitted, 'state_', None))
         iterations = max(iterations, int(getattr(fitted, 'n_iter_', 0)))
         info = max(info, int(getattr(fitted, 'info_', 0)))
         diverged = diverged or getattr(fitted, 'info_', 0) < 0
     return ChannelSeparation(backgrounds=backgrounds, foregrounds=foregrounds,
-                             residuals=np.stack(residuals), states=states,
+                             residuals=residuals, states=states,
                              iterations=iterations, info=info, diverged=diverged,
                              seconds=time.perf_counter() - started)

@@ -140,7 +140,7 @@ class OpenCVSubtractor(StreamingDetector):
         """Return False: the subtractor updates its model with every frame."""
         return False
 
-    def snapshot(self):
+    def snapshot(self, ahead=0):
         """Refuse: a subtractor has no window to solve."""
         raise ValueError(f'{self.kind} updates its model with every frame; it has no window '
                          'to solve')

@@ -26,8 +26,9 @@ OpenCV's subtractors implement the same contract in
 """
 
 from .contract import StreamingDetector
-from .results import BackgroundModel, FrameResult, SolverFailure, SolveTicket, WindowSnapshot
+from .results import (BackgroundModel, FrameResult, SolveInFlight, SolverFailure, SolveTicket,
+                      WindowSnapshot)
 from .sliding_window import SlidingWindowDetector
 
-__all__ = ['BackgroundModel', 'FrameResult', 'SlidingWindowDetector', 'SolverFailure',
-           'SolveTicket', 'StreamingDetector', 'WindowSnapshot']
+__all__ = ['BackgroundModel', 'FrameResult', 'SlidingWindowDetector', 'SolveInFlight',
+           'SolverFailure', 'SolveTicket', 'StreamingDetector', 'WindowSnapshot']

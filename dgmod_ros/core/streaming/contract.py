@@ -13,6 +13,20 @@ from the frames: :meth:`~StreamingDetector.solve_due` says when,
 without window solves implements the same methods: its ``solve_due`` is
 always False and ``install`` refuses every model.
 
+**When a solve is installed.** :meth:`~StreamingDetector.process` installs
+the solve of a snapshot taken at frame ``t`` right before masking frame
+``t + solve_lag`` (``solve_lag`` frames, a detector parameter, 0 by default
+for detectors without it), whether the solve ran in line or in another thread
+(``executor``): if it is not finished by then, ``process`` waits for it. The
+masks therefore never depend on how fast a solve runs, and a solve has
+``solve_lag`` frames of time to run beside the per-frame work. With an
+executor, a solve whose window is already final before it is due (no frame
+will be admitted in between, :meth:`~StreamingDetector.frames_until_final_solve`)
+starts at once and is installed at the frame it would have been: more time
+beside the per-frame work, the same masks.
+:meth:`~StreamingDetector.push` keeps the same rule without waiting: a solve
+finished late is installed at the first frame after it finished.
+
 Every snapshot carries a :class:`~.results.SolveTicket`: the detector object
 that took it and its configuration generation (raised by every
 :meth:`~StreamingDetector.configure`, :meth:`~StreamingDetector.reset` and
@@ -22,8 +36,9 @@ restarted is discarded and counted (``solves_discarded_``), never installed.
 """
 
 from abc import ABC, abstractmethod
+from concurrent.futures import Future
 
-from .results import SolverFailure, SolveTicket
+from .results import SolveInFlight, SolverFailure, SolveTicket
 
 
 class StreamingDetector(ABC):
@@ -60,6 +75,10 @@ class StreamingDetector(ABC):
         """
         Mask one frame at once from the current model; never runs a window solve.
 
+        A solve started with :meth:`track_solve` is installed before the frame
+        is masked once its ``solve_lag`` frames have passed and it has
+        finished (``result.installed``, ``result.solve_error``).
+
         Parameters
         ----------
         frame : ndarray (h, w) or (h, w, 3|4)
@@ -80,38 +99,115 @@ class StreamingDetector(ABC):
             For a frame that cannot be used (the detector is unchanged).
 
         """
-        return self._finish(self._ingest(frame, channel_order, value_range))
+        pending = self._ingest(frame, channel_order, value_range)
+        installed, error = self._install_finished(wait=False)
+        result = self._finish(pending)
+        result.installed, result.solve_error = installed, error
+        return result
 
-    def process(self, frame, channel_order='rgb', value_range=None):
+    def process(self, frame, channel_order='rgb', value_range=None, executor=None):
         """
-        Take a frame in, solve in line when due, then mask it (the synchronous path).
+        Take a frame in, start the solve when due, install by the lag rule, mask the frame.
 
-        The frame is buffered first, so a solve due now includes it, and it is
-        masked with the freshest model. A failed solve keeps the previous
-        model, makes the next solve start cold and is reported in
-        ``result.solve_error``.
+        The frame is taken in first, so a solve due now sees the window as it
+        is before this frame is admitted. The solve of a snapshot taken at
+        frame ``t`` is installed right before frame ``t + solve_lag`` is
+        masked (with ``solve_lag`` 0, this frame), waiting for it if needed:
+        the same masks whether the solve runs in line or in ``executor``, and
+        whatever its speed. A failed solve keeps the previous model, makes the
+        next solve start cold and is reported in ``result.solve_error``.
+
+        Parameters
+        ----------
+        frame, channel_order, value_range
+            As for :meth:`push`.
+        executor : concurrent.futures.Executor or None
+            Runs the solves (one worker is enough: one solve is in flight at a
+            time); None solves in line.
 
         Returns
         -------
         result : FrameResult
         solved : BackgroundModel or None
-            The model of the solve run for this frame, if one was due and installed.
+            The model installed before this frame was masked, if any.
 
         """
         pending = self._ingest(frame, channel_order, value_range)
-        solved, error = None, None
-        if self.solve_due():
-            try:
-                solved = self.solve(self.snapshot())
-            except SolverFailure as failure:
-                error = str(failure)
-                self.drop_warm_start()
+        installed, error = self._install_finished(wait=True)
+        ahead = 0 if executor is None or self.solve_due() else self.frames_until_final_solve()
+        if self.solve_due() or ahead:
+            snapshot = self.snapshot(ahead)
+            if executor is None:
+                future = Future()
+                try:
+                    future.set_result(self.solve(snapshot))
+                except SolverFailure as failure:
+                    future.set_exception(failure)
             else:
-                if not self.install(solved):
-                    solved = None
+                future = executor.submit(self.solve, snapshot)
+            self.track_solve(snapshot, future, ahead)
+            if self.solve_in_flight_.frames_left <= 0:
+                installed, error = self._install_finished(wait=True, count=False)
         result = self._finish(pending)
-        result.solve_error = error
-        return result, solved
+        result.installed, result.solve_error = installed, error
+        return result, installed
+
+    # ------------------------------------------------------------- install rule
+    def frames_until_final_solve(self):
+        """
+        Return in how many frames the next solve is due if its window is already final, else 0.
+
+        A positive answer lets :meth:`process` start that solve now, in its
+        executor: the snapshot taken now equals the one it would take then
+        (no frame is admitted in between), so the solve is the same and
+        is installed at the same frame. Detectors without window solves
+        answer 0.
+        """
+        return 0
+
+    def track_solve(self, snapshot, future, ahead=0):
+        """
+        Register the solve of ``snapshot``, running in ``future``, for the install rule.
+
+        The next :meth:`push` or :meth:`process` calls count frames against
+        it and install its model (or report its :class:`SolverFailure`) once
+        ``ahead + solve_lag`` frames have passed (``ahead``: the frames by
+        which an early start precedes the frame the solve is due). The first
+        solve (no model yet: masks come from the warm-up) is installed without
+        lag. One solve is in flight at a time.
+        """
+        lag = int(getattr(self, 'solve_lag', 0)) if snapshot.previous is not None else 0
+        self.solve_in_flight_ = SolveInFlight(ticket=snapshot.ticket, future=future,
+                                              frames_left=int(ahead) + lag)
+
+    def solve_in_flight(self):
+        """Tell whether a started solve waits to be installed (no new solve is due till then)."""
+        return getattr(self, 'solve_in_flight_', None) is not None
+
+    def _install_finished(self, wait, count=True):
+        """
+        Count this frame against the solve in flight; install it when its frame has come.
+
+        Returns ``(installed model or None, error message or None)``. With
+        ``wait`` a solve whose frame has come is waited for; without, a solve
+        still running stays in flight (installed at the first frame after it
+        ends).
+        """
+        in_flight = getattr(self, 'solve_in_flight_', None)
+        if in_flight is None:
+            return None, None
+        if count:
+            in_flight.frames_left -= 1
+        if in_flight.frames_left > 0 or not (wait or in_flight.future.done()):
+            return None, None
+        self.solve_in_flight_ = None
+        try:
+            model = in_flight.future.result()
+        except SolverFailure as failure:
+            if in_flight.ticket == self._ticket():
+                self.drop_warm_start()
+            return None, str(failure)
+        return (model if self.install(model) else None), None
 
     @abstractmethod
     def background_image(self):
@@ -131,8 +227,13 @@ class StreamingDetector(ABC):
         """Tell whether a window solve should run now."""
 
     @abstractmethod
-    def snapshot(self):
-        """Copy what the due solve needs (a WindowSnapshot with the current ticket)."""
+    def snapshot(self, ahead=0):
+        """
+        Copy what the due solve needs (a WindowSnapshot with the current ticket).
+
+        ``ahead`` (from :meth:`frames_until_final_solve`) takes the snapshot of
+        a solve due that many frames later; the stride count restarts there.
+        """
 
     @abstractmethod
     def solve(self, snapshot):
@@ -180,6 +281,9 @@ class StreamingDetector(ABC):
         return SolveTicket(self.owner_token_, self.generation_)
 
     def _new_generation(self):
-        """Invalidate every ticket handed out so far."""
+        """Invalidate every ticket handed out so far (a solve in flight is discarded)."""
         self._ticket()
         self.generation_ += 1
+        if getattr(self, 'solve_in_flight_', None) is not None:
+            self.solve_in_flight_ = None
+            self.solves_discarded_ = getattr(self, 'solves_discarded_', 0) + 1

@@ -35,7 +35,9 @@ class FrameResult:
         True when :meth:`StreamingDetector.background_image` has a background
         not announced before: the one rule for publishing backgrounds.
     solve_error : str or None
-        Set by :meth:`StreamingDetector.process` when a due solve failed.
+        Set when the solve whose turn it was at this frame failed.
+    installed : BackgroundModel or None
+        The solved model installed right before this frame was masked.
 
     """
 
@@ -47,6 +49,7 @@ class FrameResult:
     model_ready: bool
     new_background: bool = False
     solve_error: str = None
+    installed: object = None
 
 
 @dataclass(frozen=True)
@@ -61,6 +64,21 @@ class SolveTicket:
 
     owner: object
     generation: int
+
+
+@dataclass
+class SolveInFlight:
+    """
+    A started solve waiting for its frame (the install rule of the contract).
+
+    ``future`` (a ``concurrent.futures.Future``) gives the model or raises
+    :class:`SolverFailure`; ``frames_left`` counts down the frames until it is
+    installed.
+    """
+
+    ticket: SolveTicket
+    future: object
+    frames_left: int
 
 
 @dataclass
@@ -99,8 +117,9 @@ class BackgroundModel:
         The newest background column as an image at the processing size.
     mean_background : ndarray (rows, cols, C)
         The window's mean background (the paper's background estimate).
-    threshold : float
-        Mask threshold estimated from this window's residual.
+    threshold : float or None
+        Mask threshold estimated from this window's residual (the global
+        rule); None when solved for a per-pixel decision, which reads ``noise``.
     shape : tuple
         (rows, cols, C) processing shape the model belongs to.
     first_id, last_id : int

@@ -127,6 +127,13 @@ class SlidingWindowDetector(StreamingDetector):
         rule, coupling 5 x 5 neighbours with this weight (log-odds per
         neighbour; :mod:`~dgmod_ros.core.streaming.coherence`), in place of
         the median filter; 0: threshold and median filter.
+    solve_lag : int, default=0
+        Frames between a solve's snapshot and its install (at most
+        ``stride``): the solve of the window taken at frame ``t`` becomes the
+        model right before frame ``t + solve_lag`` is masked, so it may run
+        beside ``solve_lag`` frames of per-frame work with the same masks
+        whatever its speed (the install rule of
+        :class:`~dgmod_ros.core.streaming.contract.StreamingDetector`).
 
     Attributes
     ----------
@@ -146,7 +153,7 @@ class SlidingWindowDetector(StreamingDetector):
                  mask_rule=None, motion_threshold=0.0, min_frames=5, basis_rank=2,
                  global_change_fraction=0.7, memory_spacing=10, conditional_update=True,
                  absorb_frames=300, decision='adaptive', pixel_k=6.0, median_size=5,
-                 ghost_test=True, still_frames=50, mrf_beta=2.0):
+                 ghost_test=True, still_frames=50, mrf_beta=2.0, solve_lag=0):
         self.model = model
         self.window = window
         self.stride = stride
@@ -166,6 +173,7 @@ class SlidingWindowDetector(StreamingDetector):
         self.ghost_test = ghost_test
         self.still_frames = still_frames
         self.mrf_beta = mrf_beta
+        self.solve_lag = solve_lag
         self._validated = False
 
     # ------------------------------------------------------------- set-up
@@ -276,6 +284,8 @@ class SlidingWindowDetector(StreamingDetector):
             return background, warmup_noise(with_frame)
         background = robust_projection(model.basis, columns)
         if self.decision == 'global':
+            if model.threshold is None:     # solved for a per-pixel decision (switched since)
+                return background, self.mask_rule_.threshold_from_noise(model.noise)
             return background, model.threshold
         if model.noise is None:             # solved under the global rule
             return background, model.threshold / self.mask_rule_.k
@@ -375,17 +385,41 @@ class SlidingWindowDetector(StreamingDetector):
     def solve_due(self):
         """Tell whether a window solve should run now."""
         self._ensure_started()
+        if self.solve_in_flight():
+            return False
         if self.background_model_ is None:
             return len(self.buffer_) >= self.min_frames
         return self.since_solve_ >= self.stride
 
-    def snapshot(self):
-        """Copy the window for a solve and restart the stride count."""
+    def frames_until_final_solve(self):
+        """
+        Return in how many frames the next solve is due if no frame is admitted till then, else 0.
+
+        Only with a model and a full window: admissions then come every
+        ``memory_spacing`` frames at the earliest, so the window of the
+        next solve is known as soon as the last admission before it is in.
+        """
+        self._ensure_started()
+        if (self.solve_in_flight() or self.background_model_ is None
+                or len(self.buffer_) < self.buffer_.capacity
+                or self.buffer_.last_admitted_id is None):
+            return 0
+        ahead = int(self.stride) - self.since_solve_
+        # This frame's id; admissions happen when frames are masked (_finish).
+        frame_id = self.next_id_ - 1
+        next_admission = self.buffer_.last_admitted_id + self.buffer_.spacing
+        return ahead if 0 < ahead and frame_id + ahead <= next_admission else 0
+
+    def snapshot(self, ahead=0):
+        """Copy the window for a solve and restart the stride count (``ahead`` frames later)."""
         self._ensure_started()
         if len(self.buffer_) < 2:
             raise ValueError('a window solve needs at least 2 buffered frames')
         data = self.buffer_.stack()                            # (C, n, m)
-        self.since_solve_ = 0
+        # An early start restarts the count at the frame the solve is due;
+        # if it is discarded, the frames it took back are given back.
+        self.early_credit_ = self.since_solve_ + int(ahead) if ahead else 0
+        self.since_solve_ = -int(ahead)
         return WindowSnapshot(data=data, shape=self.shape_, first_id=self.buffer_.first_id,
                               last_id=self.buffer_.last_id, previous=self.background_model_,
                               model=self.model_, mask_rule=self.mask_rule_,
@@ -402,6 +436,12 @@ class SlidingWindowDetector(StreamingDetector):
         with another concurrent solve).
         """
         return solve_window(snapshot)
+
+    def _new_generation(self):
+        if self.solve_in_flight() and getattr(self, 'early_credit_', 0):
+            self.since_solve_ += self.early_credit_    # the early solve is due as before
+        self.early_credit_ = 0
+        super()._new_generation()
 
     def drop_warm_start(self):
         """Make the next solve start cold (after a failed one), keeping the fast path."""

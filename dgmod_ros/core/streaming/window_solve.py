@@ -68,7 +68,10 @@ def solve_window(snapshot):
             rows, cols, channels),
         mean_background=np.stack([b.mean(axis=1) for b in backgrounds], axis=1).reshape(
             rows, cols, channels),
-        threshold=separated.threshold(snapshot.mask_rule, snapshot.data),
+        # The global rule's threshold costs a median over the whole window; the
+        # per-pixel decisions read ``noise`` instead.
+        threshold=(separated.threshold(snapshot.mask_rule, snapshot.data)
+                   if snapshot.decision == 'global' else None),
         shape=snapshot.shape, first_id=snapshot.first_id, last_id=snapshot.last_id,
         states=separated.states, seconds=time.perf_counter() - started,
         iterations=separated.iterations, info=separated.info, ticket=snapshot.ticket,

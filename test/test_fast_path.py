@@ -1,0 +1,46 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""The fast path's compiled l1 projection against its numpy formulation."""
+
+from dgmod_ros.core.streaming.fast_path import (background_basis, robust_projection,
+                                                robust_projection_reference)
+import numpy as np
+import pytest
+
+
+def _frame_and_basis(rank, seed=4, n=3000, channels=3):
+    rng = np.random.default_rng(seed)
+    ramp = np.linspace(0.2, 0.8, n, dtype=np.float32)
+    window = (ramp[None, :, None] * rng.uniform(0.8, 1.2, (channels, 1, 20))
+              + 0.01 * rng.standard_normal((channels, n, 20))).astype(np.float32)
+    basis = np.zeros((channels, n, rank), dtype=np.float32)
+    for channel in range(channels):
+        own = background_basis(window[channel], rank)
+        basis[channel, :, :own.shape[1]] = own
+    frame = 1.1 * window[:, :, -1]
+    frame[:, 1000:1300] = 0.95          # a person: the l1 fit must ignore it
+    return basis, frame.astype(np.float32), ramp
+
+
+@pytest.mark.parametrize('rank', [1, 2, 3])
+def test_compiled_projection_equals_numpy(rank):
+    basis, frame, _ = _frame_and_basis(rank)
+    assert np.allclose(robust_projection(basis, frame),
+                       robust_projection_reference(basis, frame), atol=1e-5)
+
+
+def test_projection_ignores_the_foreground_and_takes_the_gain():
+    basis, frame, ramp = _frame_and_basis(2)
+    fitted = robust_projection(basis, frame)
+    background = np.delete(np.arange(frame.shape[1]), np.arange(1000, 1300))
+    # The frame is the window's last column times 1.1 outside the person.
+    assert np.abs(fitted[:, background] - frame[:, background]).max() < 0.05
+    assert np.abs(fitted[:, 1000:1300] - 0.95).min() > 0.2
+
+
+def test_projection_with_a_zero_padded_channel_basis():
+    # A channel whose background has lower rank than the others keeps zero columns.
+    basis, frame, _ = _frame_and_basis(2)
+    basis[1, :, 1] = 0.0
+    assert np.allclose(robust_projection(basis, frame),
+                       robust_projection_reference(basis, frame), atol=1e-5)
