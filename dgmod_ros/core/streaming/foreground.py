@@ -87,7 +87,7 @@ def warmup_noise(buffered):
     return max(robust_sigma(differences) / np.sqrt(2.0), _QUANTUM)
 
 
-def adaptive_mask(columns, background, noise, k, shape, median_size):
+def adaptive_mask(columns, background, noise, k, shape, median_size, lighting=None):
     """
     Return a frame's foreground at the processing size (uint8 0/255) and its distance.
 
@@ -103,11 +103,17 @@ def adaptive_mask(columns, background, noise, k, shape, median_size):
         Processing shape.
     median_size : int
         Side of the median filter (odd); <= 1 disables it.
+    lighting : LightingTest or None
+        Drops the changes that light explains
+        (:class:`~dgmod_ros.core.streaming.photometric.LightingTest`); None keeps all.
 
     """
     rows, cols = shape[:2]
     distance = np.abs(columns - background).max(axis=0)
-    mask = np.where(distance > k * noise, np.uint8(255), np.uint8(0)).reshape(rows, cols)
+    changed = distance > k * noise
+    if lighting is not None:
+        changed &= ~lighting.explains(columns, background, noise, k, shape, changed)
+    mask = np.where(changed, np.uint8(255), np.uint8(0)).reshape(rows, cols)
     if median_size > 1:
         mask = cv2.medianBlur(mask, int(median_size))
     return mask, distance.reshape(rows, cols)

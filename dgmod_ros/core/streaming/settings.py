@@ -51,6 +51,9 @@ def check_window_parameters(detector):
     size = detector.median_size
     if int(size) != size or size < 1 or size % 2 == 0:
         raise ValueError(f'median_size must be an odd positive integer, got {size!r}')
+    bits = detector.texture_bits
+    if int(bits) != bits or not 0 <= bits <= 48:
+        raise ValueError(f'texture_bits must be an integer in [0, 48], got {bits!r}')
     (detector.mask_rule or MaskRule()).validate()
 
 

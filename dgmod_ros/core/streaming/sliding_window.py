@@ -17,6 +17,7 @@ from .buffer import SceneChangeWatch
 from .contract import StreamingDetector
 from .fast_path import robust_projection
 from .foreground import adaptive_mask, ghost_blobs, to_input_size, warmup_noise
+from .photometric import LightingTest
 from .results import FrameResult, WindowSnapshot
 from .settings import assign_validated, check_window_parameters
 from .window_solve import solve_window
@@ -113,6 +114,14 @@ class SlidingWindowDetector(StreamingDetector):
         than of the frame (something in the window's frames has left; see
         :func:`~dgmod_ros.core.streaming.foreground.ghost_blobs`); their
         pixels enter the window as they are, which heals the background.
+    chroma_cue, texture_cue : bool, default=True
+        Drop the candidate pixels whose change light explains (a shadow, a
+        reflection: see :mod:`~dgmod_ros.core.streaming.photometric`), judged
+        by their chromaticity, their LBSP texture or both, and their
+        brightness ratio ('adaptive', 'uniform'); both False keeps every
+        candidate.
+    texture_bits : int, default=8
+        Largest LBSP Hamming distance of a change of light.
 
     Attributes
     ----------
@@ -132,7 +141,7 @@ class SlidingWindowDetector(StreamingDetector):
                  mask_rule=None, motion_threshold=0.0, min_frames=5, basis_rank=2,
                  global_change_fraction=0.7, memory_spacing=10, conditional_update=True,
                  absorb_frames=300, decision='adaptive', pixel_k=6.0, median_size=5,
-                 ghost_test=True):
+                 ghost_test=True, chroma_cue=True, texture_cue=True, texture_bits=8):
         self.model = model
         self.window = window
         self.stride = stride
@@ -150,6 +159,9 @@ class SlidingWindowDetector(StreamingDetector):
         self.pixel_k = pixel_k
         self.median_size = median_size
         self.ghost_test = ghost_test
+        self.chroma_cue = chroma_cue
+        self.texture_cue = texture_cue
+        self.texture_bits = texture_bits
         self._validated = False
 
     # ------------------------------------------------------------- set-up
@@ -173,6 +185,8 @@ class SlidingWindowDetector(StreamingDetector):
         self.model_ = (self.model if self.model is not None
                        else DualGraphMOD(tol=1e-3, max_iter=5))
         self.mask_rule_ = self.mask_rule or MaskRule()
+        self.lighting_ = (LightingTest(self.chroma_cue, self.texture_cue, int(self.texture_bits))
+                          if self.chroma_cue or self.texture_cue else None)
 
     def configure(self, **params):
         """
@@ -271,7 +285,8 @@ class SlidingWindowDetector(StreamingDetector):
             foreground = np.where(result.magnitude > level, np.uint8(255), np.uint8(0))
         else:
             foreground, result.magnitude = adaptive_mask(
-                columns, background, level, self.pixel_k, self.shape_, self.median_size)
+                columns, background, level, self.pixel_k, self.shape_, self.median_size,
+                self.lighting_)
             if (self.ghost_test and self.background_model_ is not None
                     and len(self.recent_) == self.recent_.maxlen):
                 ghosts = ghost_blobs(foreground, columns, background, self.recent_[0][1],
