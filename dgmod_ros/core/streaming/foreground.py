@@ -87,7 +87,8 @@ def warmup_noise(buffered):
     return max(robust_sigma(differences) / np.sqrt(2.0), _QUANTUM)
 
 
-def adaptive_mask(columns, background, noise, k, shape, median_size, lighting=None):
+def adaptive_mask(columns, background, noise, k, shape, median_size, lighting=None,
+                  chroma_level=None):
     """
     Return a frame's foreground at the processing size (uint8 0/255) and its distance.
 
@@ -106,13 +107,16 @@ def adaptive_mask(columns, background, noise, k, shape, median_size, lighting=No
     lighting : LightingTest or None
         Drops the changes that light explains
         (:class:`~dgmod_ros.core.streaming.photometric.LightingTest`); None keeps all.
+    chroma_level : ndarray (n,) or None
+        Each pixel's chromaticity noise level, for ``lighting``.
 
     """
     rows, cols = shape[:2]
     distance = np.abs(columns - background).max(axis=0)
     changed = distance > k * noise
     if lighting is not None:
-        changed &= ~lighting.explains(columns, background, noise, k, shape, changed)
+        changed &= ~lighting.explains(columns, background, noise, k, shape, changed,
+                                      chroma_level)
     mask = np.where(changed, np.uint8(255), np.uint8(0)).reshape(rows, cols)
     if median_size > 1:
         mask = cv2.medianBlur(mask, int(median_size))

@@ -17,8 +17,10 @@ light plausibly does. Horprasert et al. split a pixel's colour difference
 A candidate pixel (its distance above ``k`` noise levels) is a change of
 light when all the enabled cues agree:
 
-- chromaticity: ``c`` within ``k`` noise levels of the pixel (the level the
-  decision already uses: ``c`` is never larger than ``|I - E|``);
+- chromaticity: ``c`` within ``k`` times the pixel's own chromaticity noise
+  level (:func:`chroma_noise`: read from the window's ``D`` and ``L`` the way
+  :func:`~dgmod_ros.core.streaming.foreground.pixel_noise` reads the level of
+  the channel-wise difference);
 - texture: the LBSP descriptor distance to the background
   (:mod:`~dgmod_ros.core.streaming.texture`) at most ``texture_bits``;
 - brightness: ``|alpha - 1|`` within LBSP's relative threshold
@@ -34,6 +36,7 @@ Workshop, 1999.
 
 import numpy as np
 
+from .foreground import pixel_noise
 from .texture import descriptor_distance, RELATIVE_THRESHOLD
 
 # Smallest squared background norm: a black pixel has no chromaticity.
@@ -62,6 +65,28 @@ def distortion(frame, background):
     return alpha, np.sqrt(np.einsum('c...,c...->...', across, across))
 
 
+def chroma_noise(data, residual, shape, observed=None, uniform=False):
+    """
+    Return each pixel's chromaticity noise level (n,) float32 from a window solve.
+
+    Parameters
+    ----------
+    data : ndarray (C, n, m)
+        The window ``D``.
+    residual : ndarray (C, n, m)
+        ``D - L``.
+    shape : tuple (rows, cols, C)
+        Processing shape.
+    observed : ndarray (n, m) bool or None
+        Entries that hold the frame's own pixel; None: all.
+    uniform : bool
+        Give every pixel the typical level.
+
+    """
+    _, chroma = distortion(data, data - residual)
+    return pixel_noise(chroma[None], shape, observed, uniform)
+
+
 class LightingTest:
     """
     Tell which candidate foreground pixels are changes of light.
@@ -83,7 +108,7 @@ class LightingTest:
         self.texture = texture
         self.texture_bits = texture_bits
 
-    def explains(self, columns, background, noise, k, shape, candidates):
+    def explains(self, columns, background, noise, k, shape, candidates, chroma_level=None):
         """
         Return, for every pixel, whether it is a candidate whose change light explains.
 
@@ -99,6 +124,9 @@ class LightingTest:
             Processing shape.
         candidates : ndarray (n,) bool
             Pixels whose distance is above ``k`` noise levels.
+        chroma_level : ndarray (n,) or None
+            Each pixel's chromaticity noise level (:func:`chroma_noise`);
+            None: ``noise`` (an upper bound: ``c <= |I - E|``).
 
         Returns
         -------
@@ -114,7 +142,8 @@ class LightingTest:
         alpha, chroma = distortion(frame, reference)
         light = np.abs(alpha - 1.0) <= RELATIVE_THRESHOLD
         if self.chroma:
-            light &= chroma <= k * level
+            chroma_level = level if chroma_level is None else chroma_level[pixels]
+            light &= chroma <= k * chroma_level
         if self.texture:
             rows, cols, channels = shape
             threshold = np.maximum(RELATIVE_THRESHOLD * reference, k * level)

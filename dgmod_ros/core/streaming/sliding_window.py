@@ -284,9 +284,10 @@ class SlidingWindowDetector(StreamingDetector):
             result.mask = self.mask_rule_.apply(result.magnitude, level, self.input_shape_)
             foreground = np.where(result.magnitude > level, np.uint8(255), np.uint8(0))
         else:
+            model = self.background_model_
             foreground, result.magnitude = adaptive_mask(
                 columns, background, level, self.pixel_k, self.shape_, self.median_size,
-                self.lighting_)
+                self.lighting_, model.chroma_noise if model is not None else None)
             if (self.ghost_test and self.background_model_ is not None
                     and len(self.recent_) == self.recent_.maxlen):
                 ghosts = ghost_blobs(foreground, columns, background, self.recent_[0][1],
