@@ -81,7 +81,8 @@ def main():
     print(f'  {"per-frame path, total":45s} {total:7.2f} ms per frame')
     quarter_ms = median_ms(lambda: lighting.explains(columns, background, model.noise, k, shape,
                                                      quarter, chroma_level), args.repeats)
-    print(f'  {"lighting test, a quarter of the view candidate":45s} {quarter_ms:7.2f} ms per frame')
+    print(f'  {"lighting test, a quarter of the view candidate":45s} {quarter_ms:7.2f} '
+          'ms per frame')
     # The earlier default per-frame path in the same run, as the reference
     # (grey projection on one channel's basis, one threshold, 3 x 3 morphology).
     grey, _ = frame_columns(frame, detector.scale, 'gray', 'rgb', None)

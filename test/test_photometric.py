@@ -15,7 +15,7 @@ K = 6.0
 
 
 def _floor(seed=0):
-    """A colour floor (3, rows, cols) with tiles: texture of its own."""
+    """Return a colour floor (3, rows, cols) of tiles: a texture of its own."""
     rng = np.random.default_rng(seed)
     tiles = np.kron(rng.uniform(0.45, 0.75, (ROWS // 8, COLS // 8)), np.ones((8, 8)))
     tint = np.array([1.0, 0.85, 0.7])[:, None, None]

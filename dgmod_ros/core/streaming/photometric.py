@@ -32,6 +32,7 @@ References
 T. Horprasert, D. Harwood, L. S. Davis, "A statistical approach for real-time
 robust background subtraction and shadow detection", IEEE ICCV Frame-Rate
 Workshop, 1999.
+
 """
 
 import numpy as np

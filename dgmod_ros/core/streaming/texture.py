@@ -24,6 +24,7 @@ G.-A. Bilodeau, J.-P. Jodoin, N. Saunier, "Change detection in feature space
 using local binary similarity patterns", CRV 2013.
 P.-L. St-Charles, G.-A. Bilodeau, "Improving background subtraction using
 local binary similarity patterns", WACV 2014 (LOBSTER).
+
 """
 
 import cv2
