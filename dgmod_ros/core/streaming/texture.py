@@ -16,7 +16,8 @@ flips no bit; a body with its own edges and shades flips many.
 Each colour channel gets its own pattern; the distances add up over the
 channels (0 to 16 C bits). The distance is computed only at the pixels asked
 for (the decision's candidates), which keeps its cost proportional to the
-foreground.
+foreground, by a serial numba kernel (no threads: it runs in the image
+callback beside the solve thread's parallel kernels).
 
 References
 ----------
@@ -27,21 +28,36 @@ local binary similarity patterns", WACV 2014 (LOBSTER).
 
 """
 
-import cv2
+from numba import njit
 import numpy as np
+
+from .. import kernels  # noqa: F401 (sets numba's cache folder before the first compile)
 
 #: The 16 neighbours (row, col offsets) of the 5 x 5 double-cross pattern.
 PATTERN = ((-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1),
            (-2, -2), (-2, 0), (-2, 2), (0, -2), (0, 2), (2, -2), (2, 0), (2, 2))
 #: LBSP's relative similarity threshold (LOBSTER's published default, 0.365).
 RELATIVE_THRESHOLD = 0.365
-_REACH = 2
+_OFFSETS = np.array(PATTERN, dtype=np.int64)
 
 
-def _padded_flat(image):
-    """Return a (C, rows, cols) image with its border replicated by the pattern's reach, flat."""
-    return np.stack([cv2.copyMakeBorder(channel, _REACH, _REACH, _REACH, _REACH,
-                                        cv2.BORDER_REPLICATE).ravel() for channel in image])
+@njit(cache=True, nogil=True)
+def _hamming(frame, background, threshold, pixels, offsets, out):
+    """Count the differing LBSP bits at each pixel; the image border is replicated."""
+    channels, rows, cols = frame.shape
+    for index in range(pixels.shape[0]):
+        row, col = pixels[index] // cols, pixels[index] % cols
+        count = 0
+        for channel in range(channels):
+            reference = background[channel, row, col]
+            limit = threshold[channel, index]
+            for o in range(offsets.shape[0]):
+                r = min(max(row + offsets[o, 0], 0), rows - 1)
+                c = min(max(col + offsets[o, 1], 0), cols - 1)
+                in_frame = abs(frame[channel, r, c] - reference) > limit
+                in_background = abs(background[channel, r, c] - reference) > limit
+                count += in_frame != in_background
+        out[index] = count
 
 
 def descriptor_distance(frame, background, threshold, pixels):
@@ -64,18 +80,9 @@ def descriptor_distance(frame, background, threshold, pixels):
         Bits that differ, summed over the channels.
 
     """
-    frame = np.asarray(frame, dtype=np.float32)
-    background = np.asarray(background, dtype=np.float32)
-    cols = frame.shape[2]
-    width = cols + 2 * _REACH
-    pixels = np.asarray(pixels)
-    centre = (pixels // cols + _REACH) * width + pixels % cols + _REACH
-    frame_flat, background_flat = _padded_flat(frame), _padded_flat(background)
-    reference = background_flat[:, centre]
-    distance = np.zeros(reference.shape, dtype=np.uint8)
-    for dr, dc in PATTERN:
-        neighbour = centre + dr * width + dc
-        in_frame = np.abs(frame_flat[:, neighbour] - reference) > threshold
-        in_background = np.abs(background_flat[:, neighbour] - reference) > threshold
-        distance += in_frame != in_background
-    return distance.sum(axis=0, dtype=np.uint8)
+    pixels = np.ascontiguousarray(pixels, dtype=np.int64)
+    out = np.empty(pixels.shape[0], dtype=np.uint8)
+    _hamming(np.ascontiguousarray(frame, dtype=np.float32),
+             np.ascontiguousarray(background, dtype=np.float32),
+             np.ascontiguousarray(threshold, dtype=np.float32), pixels, _OFFSETS, out)
+    return out
