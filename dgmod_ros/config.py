@@ -123,6 +123,14 @@ PARAMETERS = (
               '(adaptive, uniform)', 0.1, 100.0),
     Parameter('median_size', 5, 'median filter of the adaptive decision at the processing '
               'size (odd; 1 = off)', 1, 15, 2),
+    Parameter('chroma_cue', True, 'a change of light (shadow, reflection) keeps the '
+              'chromaticity: pixels whose chromaticity distortion stays within pixel_k noise '
+              'levels may be taken for one (adaptive, uniform; rgb)'),
+    Parameter('texture_cue', True, 'a change of light keeps the local texture: pixels whose '
+              'LBSP descriptor stays within texture_bits of the background may be taken for '
+              'one (adaptive, uniform)'),
+    Parameter('texture_bits', 8, 'largest LBSP Hamming distance (of 16 bits per channel) of a '
+              'change of light', 0, 48),
     Parameter('mask_threshold', 0.0, 'fixed threshold on |S| for data in [0, 1]; 0 = auto '
               '(max(mask_min_threshold, mask_k * robust sigma of D - L))', 0.0, 1.0),
     Parameter('mask_k', 5.0, 'multiple of the robust noise level of the auto threshold',
@@ -243,7 +251,9 @@ def detector_settings(values):
             'absorb_frames': values['absorb_frames'], 'decision': values['decision'],
             'pixel_k': values['pixel_k'], 'median_size': values['median_size'],
             'ghost_test': values['ghost_test'], 'still_frames': values['still_frames'],
-            'mrf_beta': values['mrf_beta'], 'solve_lag': values['solve_lag']}
+            'mrf_beta': values['mrf_beta'], 'chroma_cue': values['chroma_cue'],
+            'texture_cue': values['texture_cue'], 'texture_bits': values['texture_bits'],
+            'solve_lag': values['solve_lag']}
 
 
 def validate(values):

@@ -18,6 +18,9 @@ Modules, one job each:
   with their foreground replaced by the background (conditional update).
 - :mod:`.fast_path`: a frame's background from the last solve (l1 projection by IRLS).
 - :mod:`.foreground`: the decision: each pixel against its own noise level, the ghost test.
+- :mod:`.photometric`: the lighting test of the decision (brightness ratio,
+  chromaticity), which drops shadows and reflections.
+- :mod:`.texture`: the LBSP descriptor distance between a frame and its background.
 - :mod:`.window_solve`: one window solve, snapshot in, background model out.
 - :mod:`.sliding_window`: :class:`SlidingWindowDetector`, which puts them together.
 

@@ -99,7 +99,8 @@ def warmup_noise(buffered):
     return max(_MAD_TO_SIGMA * float(np.median(differences)) / np.sqrt(2.0), _QUANTUM)
 
 
-def adaptive_mask(columns, background, noise, k, shape, median_size, mrf_beta=0.0):
+def adaptive_mask(columns, background, noise, k, shape, median_size, mrf_beta=0.0,
+                  lighting=None, chroma_level=None):
     """
     Return a frame's foreground at the processing size (uint8 0/255) and its distance.
 
@@ -118,14 +119,27 @@ def adaptive_mask(columns, background, noise, k, shape, median_size, mrf_beta=0.
     mrf_beta : float
         > 0: the Potts field of :func:`~dgmod_ros.core.streaming.coherence.mean_field_mask`
         with this coupling decides instead of the threshold and the median filter.
+    lighting : LightingTest or None
+        Drops the changes that light explains
+        (:class:`~dgmod_ros.core.streaming.photometric.LightingTest`); None keeps all.
+        Under the field, an explained pixel counts as background evidence (distance 0).
+    chroma_level : ndarray (n,) or None
+        Each pixel's chromaticity noise level, for ``lighting``.
 
     """
     rows, cols = shape[:2]
     distance = np.abs(columns - background).max(axis=0)
+    changed = distance > k * noise
+    evidence = distance
+    if lighting is not None:
+        explained = lighting.explains(columns, background, noise, k, shape, changed,
+                                      chroma_level)
+        changed &= ~explained
+        evidence = np.where(explained, np.float32(0), distance)
     if mrf_beta > 0:
-        mask = mean_field_mask(distance, noise, k, mrf_beta, shape)
+        mask = mean_field_mask(evidence, noise, k, mrf_beta, shape)
         return mask, distance.reshape(rows, cols)
-    mask = np.where(distance > k * noise, np.uint8(255), np.uint8(0)).reshape(rows, cols)
+    mask = np.where(changed, np.uint8(255), np.uint8(0)).reshape(rows, cols)
     if median_size > 1:
         mask = cv2.medianBlur(mask, int(median_size))
     return mask, distance.reshape(rows, cols)

@@ -132,6 +132,8 @@ class BackgroundModel:
         The snapshot's ticket: who may install this model.
     noise : ndarray (n,) or None
         Each pixel's noise level (the adaptive decision), None for the global rule.
+    chroma_noise : ndarray (n,) or None
+        Each pixel's chromaticity noise level (the lighting test, colour only).
     first_column : int or None
         Admission count of the window's oldest column.
 
@@ -151,3 +153,4 @@ class BackgroundModel:
     ticket: SolveTicket = None
     noise: np.ndarray = None
     first_column: int = None
+    chroma_noise: np.ndarray = None

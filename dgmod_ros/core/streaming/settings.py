@@ -56,6 +56,9 @@ def check_window_parameters(detector):
         raise ValueError(f'still_frames must be an integer >= 0, got {still!r}')
     if not (np.isfinite(detector.mrf_beta) and detector.mrf_beta >= 0):
         raise ValueError(f'mrf_beta must be >= 0, got {detector.mrf_beta!r}')
+    bits = detector.texture_bits
+    if int(bits) != bits or not 0 <= bits <= 48:
+        raise ValueError(f'texture_bits must be an integer in [0, 48], got {bits!r}')
     lag = detector.solve_lag
     if int(lag) != lag or not 0 <= lag <= stride:
         raise ValueError(f'solve_lag must be an integer in [0, stride={stride}], got {lag!r}')

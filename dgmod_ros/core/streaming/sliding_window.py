@@ -18,6 +18,7 @@ from .contract import StreamingDetector
 from .fast_path import robust_projection
 from .foreground import adaptive_mask, ghost_blobs, to_input_size, warmup_noise
 from .held_foreground import still_age, still_blob_pixels
+from .photometric import LightingTest
 from .results import FrameResult, WindowSnapshot
 from .settings import assign_validated, check_window_parameters
 from .window_solve import solve_window
@@ -127,6 +128,14 @@ class SlidingWindowDetector(StreamingDetector):
         rule, coupling 5 x 5 neighbours with this weight (log-odds per
         neighbour; :mod:`~dgmod_ros.core.streaming.coherence`), in place of
         the median filter; 0: threshold and median filter.
+    chroma_cue, texture_cue : bool, default=True
+        Drop the candidate pixels whose change light explains (a shadow, a
+        reflection: see :mod:`~dgmod_ros.core.streaming.photometric`), judged
+        by their chromaticity, their LBSP texture or both, and their
+        brightness ratio ('adaptive', 'uniform'); both False keeps every
+        candidate.
+    texture_bits : int, default=8
+        Largest LBSP Hamming distance of a change of light.
     solve_lag : int, default=0
         Frames between a solve's snapshot and its install (at most
         ``stride``): the solve of the window taken at frame ``t`` becomes the
@@ -153,7 +162,8 @@ class SlidingWindowDetector(StreamingDetector):
                  mask_rule=None, motion_threshold=0.0, min_frames=5, basis_rank=2,
                  global_change_fraction=0.7, memory_spacing=10, conditional_update=True,
                  absorb_frames=300, decision='adaptive', pixel_k=6.0, median_size=5,
-                 ghost_test=True, still_frames=50, mrf_beta=2.0, solve_lag=0):
+                 ghost_test=True, still_frames=50, mrf_beta=2.0, chroma_cue=True,
+                 texture_cue=True, texture_bits=8, solve_lag=0):
         self.model = model
         self.window = window
         self.stride = stride
@@ -173,6 +183,9 @@ class SlidingWindowDetector(StreamingDetector):
         self.ghost_test = ghost_test
         self.still_frames = still_frames
         self.mrf_beta = mrf_beta
+        self.chroma_cue = chroma_cue
+        self.texture_cue = texture_cue
+        self.texture_bits = texture_bits
         self.solve_lag = solve_lag
         self._validated = False
 
@@ -197,6 +210,8 @@ class SlidingWindowDetector(StreamingDetector):
         self.model_ = (self.model if self.model is not None
                        else DualGraphMOD(tol=1e-3, max_iter=5))
         self.mask_rule_ = self.mask_rule or MaskRule()
+        self.lighting_ = (LightingTest(self.chroma_cue, self.texture_cue, int(self.texture_bits))
+                          if self.chroma_cue or self.texture_cue else None)
 
     def configure(self, **params):
         """
@@ -300,9 +315,11 @@ class SlidingWindowDetector(StreamingDetector):
             result.mask = self.mask_rule_.apply(result.magnitude, level, self.input_shape_)
             foreground = np.where(result.magnitude > level, np.uint8(255), np.uint8(0))
         else:
+            model = self.background_model_
             foreground, result.magnitude = adaptive_mask(
                 columns, background, level, self.pixel_k, self.shape_, self.median_size,
-                self.mrf_beta)
+                self.mrf_beta, self.lighting_,
+                model.chroma_noise if model is not None else None)
             if (self.ghost_test and self.background_model_ is not None
                     and len(self.recent_) == self.recent_.maxlen):
                 ghosts = ghost_blobs(foreground, columns, background, self.recent_[0][1],

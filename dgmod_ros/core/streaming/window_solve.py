@@ -8,6 +8,7 @@ import numpy as np
 
 from .fast_path import background_basis
 from .foreground import pixel_noise
+from .photometric import chroma_noise
 from .results import BackgroundModel, SolverFailure
 from ..separation import separate_channels
 
@@ -54,10 +55,13 @@ def solve_window(snapshot):
     backgrounds = separated.backgrounds
     if separated.diverged or not all(np.all(np.isfinite(b)) for b in backgrounds):
         raise SolverFailure('window solve produced non-finite values')
-    noise = None
+    noise = chroma = None
     if snapshot.decision != 'global':
-        noise = pixel_noise(separated.residuals, snapshot.shape, snapshot.observed,
-                            uniform=snapshot.decision == 'uniform')
+        uniform = snapshot.decision == 'uniform'
+        noise = pixel_noise(separated.residuals, snapshot.shape, snapshot.observed, uniform)
+        if channels == 3:
+            chroma = chroma_noise(snapshot.data, separated.residuals, snapshot.shape,
+                                  snapshot.observed, uniform)
     bases = [background_basis(b, int(snapshot.basis_rank)) for b in backgrounds]
     basis = np.zeros((channels, rows * cols, max(b.shape[1] for b in bases)), dtype=np.float32)
     for channel, channel_basis in enumerate(bases):
@@ -75,4 +79,4 @@ def solve_window(snapshot):
         shape=snapshot.shape, first_id=snapshot.first_id, last_id=snapshot.last_id,
         states=separated.states, seconds=time.perf_counter() - started,
         iterations=separated.iterations, info=separated.info, ticket=snapshot.ticket,
-        noise=noise, first_column=snapshot.first_column)
+        noise=noise, first_column=snapshot.first_column, chroma_noise=chroma)

@@ -1,0 +1,156 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""
+Changes that light explains: shadows, reflections, highlights.
+
+A shadow or a reflection on a polished floor scales the background's colour
+and leaves its texture in place; a person changes the colour's direction
+(chromaticity), the local pattern of shades, or the brightness by more than
+light plausibly does. Horprasert et al. split a pixel's colour difference
+``I - E`` (frame ``I``, background ``E``, RGB vectors) into a part along
+``E`` and a part across it. With ``alpha = <I, E> / <E, E>``:
+
+- brightness ratio ``alpha`` (1: unchanged; a shadow is below 1, a
+  reflection above);
+- chromaticity distortion ``c = |I - alpha E|``, in the units of the data.
+
+A candidate pixel (its distance above ``k`` noise levels) is a change of
+light when all the enabled cues agree:
+
+- chromaticity: ``c`` within ``k`` times the pixel's own chromaticity noise
+  level (:func:`chroma_noise`: read from the window's ``D`` and ``L`` the way
+  :func:`~dgmod_ros.core.streaming.foreground.pixel_noise` reads the level of
+  the channel-wise difference);
+- texture: the LBSP descriptor distance to the background
+  (:mod:`~dgmod_ros.core.streaming.texture`) at most ``texture_bits``;
+- brightness: ``|alpha - 1|`` within LBSP's relative threshold
+  (:data:`~dgmod_ros.core.streaming.texture.RELATIVE_THRESHOLD`), the one
+  share of a value below which both cues call two values similar.
+
+References
+----------
+T. Horprasert, D. Harwood, L. S. Davis, "A statistical approach for real-time
+robust background subtraction and shadow detection", IEEE ICCV Frame-Rate
+Workshop, 1999.
+
+"""
+
+import numpy as np
+
+from .foreground import pixel_noise
+from .texture import descriptor_distance, RELATIVE_THRESHOLD
+
+# Smallest squared background norm: a black pixel has no chromaticity.
+_DARK = 1e-6
+
+
+def distortion(frame, background):
+    """
+    Return the brightness ratio ``alpha`` and chromaticity distortion ``c`` of a frame.
+
+    Parameters
+    ----------
+    frame, background : ndarray (C, ...)
+        Colour channels first, any trailing shape.
+
+    Returns
+    -------
+    alpha, chroma : ndarray (...) float32
+
+    """
+    frame = np.asarray(frame, dtype=np.float32)
+    background = np.asarray(background, dtype=np.float32)
+    energy = np.maximum(np.einsum('c...,c...->...', background, background), _DARK)
+    alpha = np.einsum('c...,c...->...', frame, background) / energy
+    across = frame - alpha[None] * background
+    return alpha, np.sqrt(np.einsum('c...,c...->...', across, across))
+
+
+def chroma_noise(data, residual, shape, observed=None, uniform=False):
+    """
+    Return each pixel's chromaticity noise level (n,) float32 from a window solve.
+
+    Parameters
+    ----------
+    data : ndarray (C, n, m)
+        The window ``D``.
+    residual : ndarray (C, n, m)
+        ``D - L``.
+    shape : tuple (rows, cols, C)
+        Processing shape.
+    observed : ndarray (n, m) bool or None
+        Entries that hold the frame's own pixel; None: all.
+    uniform : bool
+        Give every pixel the typical level.
+
+    """
+    _, chroma = distortion(data, data - residual)
+    return pixel_noise(chroma[None], shape, observed, uniform)
+
+
+class LightingTest:
+    """
+    Tell which candidate foreground pixels are changes of light.
+
+    Parameters
+    ----------
+    chroma : bool, default=True
+        Use the chromaticity cue.
+    texture : bool, default=True
+        Use the LBSP texture cue.
+    texture_bits : int, default=8
+        Largest LBSP Hamming distance (of ``16 C`` bits) that a change of
+        light may have.
+
+    """
+
+    def __init__(self, chroma=True, texture=True, texture_bits=8):
+        self.chroma = chroma
+        self.texture = texture
+        self.texture_bits = texture_bits
+
+    def explains(self, columns, background, noise, k, shape, candidates, chroma_level=None):
+        """
+        Return, for every pixel, whether it is a candidate whose change light explains.
+
+        Parameters
+        ----------
+        columns, background : ndarray (C, n)
+            The frame and its background.
+        noise : ndarray (n,) or float
+            Each pixel's noise level.
+        k : float
+            Multiple of the noise level that counts as a change.
+        shape : tuple (rows, cols, C)
+            Processing shape.
+        candidates : ndarray (n,) bool
+            Pixels whose distance is above ``k`` noise levels.
+        chroma_level : ndarray (n,) or None
+            Each pixel's chromaticity noise level (:func:`chroma_noise`);
+            None: ``noise`` (an upper bound: ``c <= |I - E|``).
+
+        Returns
+        -------
+        ndarray (n,) bool
+
+        """
+        pixels = np.flatnonzero(candidates)
+        explained = np.zeros(candidates.shape, dtype=bool)
+        if pixels.size == 0:
+            return explained
+        level = np.broadcast_to(np.asarray(noise, dtype=np.float32), candidates.shape)[pixels]
+        frame, reference = columns[:, pixels], background[:, pixels]
+        alpha, chroma = distortion(frame, reference)
+        light = np.abs(alpha - 1.0) <= RELATIVE_THRESHOLD
+        if self.chroma:
+            chroma_level = level if chroma_level is None else chroma_level[pixels]
+            light &= chroma <= k * chroma_level
+        if self.texture:
+            rows, cols, channels = shape
+            threshold = np.maximum(RELATIVE_THRESHOLD * reference, k * level)
+            bits = descriptor_distance(columns.reshape(channels, rows, cols),
+                                       background.reshape(channels, rows, cols),
+                                       threshold, pixels)
+            light &= bits <= self.texture_bits
+        explained[pixels] = light
+        return explained
