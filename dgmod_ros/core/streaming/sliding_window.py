@@ -314,12 +314,17 @@ class SlidingWindowDetector(StreamingDetector):
             result.magnitude = np.abs(columns - background).max(axis=0).reshape(rows, cols)
             result.mask = self.mask_rule_.apply(result.magnitude, level, self.input_shape_)
             foreground = np.where(result.magnitude > level, np.uint8(255), np.uint8(0))
+            changed = result.mask
         else:
             model = self.background_model_
             foreground, result.magnitude = adaptive_mask(
                 columns, background, level, self.pixel_k, self.shape_, self.median_size,
                 self.mrf_beta, self.lighting_,
                 model.chroma_noise if model is not None else None)
+            # The scene-change rule counts every change, light included: after
+            # the lights of most of the view switch, the lighting test would
+            # hide the change while the window still holds the old light.
+            changed = result.magnitude.ravel() > self.pixel_k * level
             if (self.ghost_test and self.background_model_ is not None
                     and len(self.recent_) == self.recent_.maxlen):
                 ghosts = ghost_blobs(foreground, columns, background, self.recent_[0][1],
@@ -334,7 +339,7 @@ class SlidingWindowDetector(StreamingDetector):
         result.model_ready = self.background_model_ is not None
         result.new_background = self.background_pending_
         self.background_pending_ = False
-        if len(self.buffer_) and self.scene_watch_.observe(result.mask,
+        if len(self.buffer_) and self.scene_watch_.observe(changed,
                                                            self.global_change_fraction):
             self._restart_from_newest(SceneChangeWatch.FRAMES)
         return result
