@@ -107,7 +107,7 @@ PARAMETERS = (
               "level from the window's residual; uniform: one level for all pixels; global: "
               'the mask_* rule (one threshold, morphology)',
               choices=('adaptive', 'uniform', 'global')),
-    Parameter('noise_source', 'max', "residual of the window that gives each pixel's noise "
+    Parameter('noise_source', 'solve', "residual of the window that gives each pixel's noise "
               "level: solve: the solve's D - L; projection / least_squares: each frame against "
               "its robust / least-squares projection on the fast path's basis (what the per-frame "
               'decision thresholds); max: the larger of the solve and projection levels',

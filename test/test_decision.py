@@ -139,7 +139,7 @@ def test_mean_field_fills_a_weak_pixel_inside_a_silhouette():
 
 
 def _window_on_a_basis(seed=1, pixels=400, frames=6):
-    """A rank-2 window (two orthonormal columns per channel), an outlier patch, noise."""
+    """Return a rank-2 window (orthonormal basis per channel) with an outlier patch and noise."""
     rng = np.random.default_rng(seed)
     basis = np.stack([np.linalg.qr(rng.normal(size=(pixels, 2)))[0] for _ in range(3)])
     data = basis @ rng.normal(size=(3, 2, frames)) + rng.normal(0, 0.01, (3, pixels, frames))

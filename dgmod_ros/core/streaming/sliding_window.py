@@ -105,7 +105,7 @@ class SlidingWindowDetector(StreamingDetector):
         'adaptive': each pixel against ``pixel_k`` times its own noise level;
         'uniform': the same with the frame's typical noise level for all
         pixels; 'global': the ``mask_rule`` (one threshold, morphology).
-    noise_source : {'solve', 'projection', 'least_squares', 'max'}, default='max'
+    noise_source : {'solve', 'projection', 'least_squares', 'max'}, default='solve'
         The window residual each pixel's noise level is read from: the
         solve's ``D - L``, each column against its robust or least-squares
         projection on the fast path's basis (the distance the per-frame
@@ -151,8 +151,8 @@ class SlidingWindowDetector(StreamingDetector):
     def __init__(self, model=None, window=30, stride=10, scale=0.5, color='rgb',
                  mask_rule=None, motion_threshold=0.0, min_frames=5, basis_rank=2,
                  global_change_fraction=0.7, memory_spacing=10, conditional_update=True,
-                 absorb_frames=300, decision='adaptive', noise_source='max', pixel_k=6.0, median_size=5,
-                 ghost_test=True, still_frames=50, mrf_beta=2.0):
+                 absorb_frames=300, decision='adaptive', noise_source='solve', pixel_k=6.0,
+                 median_size=5, ghost_test=True, still_frames=50, mrf_beta=2.0):
         self.model = model
         self.window = window
         self.stride = stride
