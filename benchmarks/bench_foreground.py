@@ -19,7 +19,7 @@ import cv2
 from dgmod_ros import config
 from dgmod_ros.core.preprocess import frame_columns
 from dgmod_ros.core.streaming.background_memory import conditional_columns
-from dgmod_ros.core.streaming.fast_path import robust_projection
+from dgmod_ros.core.streaming.fast_path import projection_residual, robust_projection
 from dgmod_ros.core.streaming.foreground import (adaptive_mask, ghost_blobs, pixel_noise,
                                                  to_input_size)
 from dgmod_ros.core.streaming.held_foreground import still_age, still_blob_pixels
@@ -114,6 +114,11 @@ def main():
           f'{noise / stride:6.2f} ms per frame')
     print(f'  {"  of which chromaticity noise levels":45s} {chroma:7.1f} ms per solve, '
           f'{chroma / stride:6.2f} ms per frame')
+    for robust, name in ((True, 'IRLS'), (False, 'least-squares')):
+        projected = median_ms(lambda: projection_residual(model.basis, snapshot.data, robust),
+                              max(3, args.repeats // 10))
+        print(f'  {"  noise_source residual, " + name + " projection":45s} {projected:7.1f} '
+              f'ms per solve, {projected / stride:6.2f} ms per frame')
 
 
 if __name__ == '__main__':

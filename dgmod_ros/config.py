@@ -111,6 +111,11 @@ PARAMETERS = (
               "level from the window's residual; uniform: one level for all pixels; global: "
               'the mask_* rule (one threshold, morphology)',
               choices=('adaptive', 'uniform', 'global')),
+    Parameter('noise_source', 'solve', "residual of the window that gives each pixel's noise "
+              "level: solve: the solve's D - L; projection / least_squares: each frame against "
+              "its robust / least-squares projection on the fast path's basis (what the per-frame "
+              'decision thresholds); max: the larger of the solve and projection levels',
+              choices=('solve', 'projection', 'least_squares', 'max')),
     Parameter('ghost_test', True, 'drop still blobs whose outline is an edge of the background '
               'rather than of the frame (ghosts of what has left); they heal the window'),
     Parameter('still_frames', 50, 'drop pixels that have been in a still blob (nothing in it '
@@ -249,6 +254,7 @@ def detector_settings(values):
             'memory_spacing': values['memory_spacing'],
             'conditional_update': values['conditional_update'],
             'absorb_frames': values['absorb_frames'], 'decision': values['decision'],
+            'noise_source': values['noise_source'],
             'pixel_k': values['pixel_k'], 'median_size': values['median_size'],
             'ghost_test': values['ghost_test'], 'still_frames': values['still_frames'],
             'mrf_beta': values['mrf_beta'], 'chroma_cue': values['chroma_cue'],

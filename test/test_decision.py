@@ -4,6 +4,7 @@
 
 from dgmod_ros.core.streaming import SlidingWindowDetector
 from dgmod_ros.core.streaming.coherence import mean_field_mask
+from dgmod_ros.core.streaming.fast_path import projection_residual, robust_projection
 from dgmod_ros.core.streaming.foreground import warmup_noise
 from dgmod_ros.core.streaming.held_foreground import still_age, still_blob_pixels
 import numpy as np
@@ -135,3 +136,55 @@ def test_mean_field_fills_a_weak_pixel_inside_a_silhouette():
     assert mask[9, 13]
     assert mask[4:16, 10:18].all()
     assert mask.sum() == 12 * 8
+
+
+def _window_on_a_basis(seed=1, pixels=400, frames=6):
+    """Return a rank-2 window (orthonormal basis per channel) with an outlier patch and noise."""
+    rng = np.random.default_rng(seed)
+    basis = np.stack([np.linalg.qr(rng.normal(size=(pixels, 2)))[0] for _ in range(3)])
+    data = basis @ rng.normal(size=(3, 2, frames)) + rng.normal(0, 0.01, (3, pixels, frames))
+    data[:, :40, 2] += 1.0                                     # a person in frame 2
+    return basis.astype(np.float32), data.astype(np.float32)
+
+
+def test_projection_residual_is_each_column_minus_its_robust_projection():
+    basis, data = _window_on_a_basis()
+    residual = projection_residual(basis, data)
+    for column in range(data.shape[2]):
+        expected = data[..., column] - robust_projection(basis, data[..., column])
+        np.testing.assert_allclose(residual[..., column], expected, atol=1e-4)
+
+
+def test_projection_residual_least_squares_is_the_orthogonal_complement():
+    basis, data = _window_on_a_basis()
+    residual = projection_residual(basis, data, robust=False)
+    expected = data - basis @ np.swapaxes(basis, 1, 2) @ data
+    np.testing.assert_allclose(residual, expected, atol=1e-4)
+    # The robust fit ignores the patch; least squares spreads it over the frame.
+    robust = projection_residual(basis, data)
+    assert np.median(np.abs(robust[:, 40:, 2])) < np.median(np.abs(residual[:, 40:, 2]))
+
+
+def test_projection_residual_skips_unused_basis_columns():
+    basis, data = _window_on_a_basis()
+    padded = np.concatenate([basis, np.zeros_like(basis[..., :1])], axis=2)
+    np.testing.assert_allclose(projection_residual(padded, data),
+                               projection_residual(basis, data), atol=1e-5)
+
+
+@pytest.mark.parametrize('source', ['projection', 'least_squares', 'max'])
+def test_every_noise_source_gives_a_positive_level_per_pixel(source):
+    rng = np.random.default_rng(4)
+    detector = SlidingWindowDetector(window=8, stride=4, noise_source=source)
+    background = rng.uniform(0.2, 0.8, (24, 32, 3)).astype(np.float32)
+    for _ in range(12):
+        frame = background + rng.normal(0, 0.01, background.shape).astype(np.float32)
+        detector.process((np.clip(frame, 0, 1) * 255).astype(np.uint8))
+    noise = detector.background_model_.noise
+    assert noise.shape == (detector.shape_[0] * detector.shape_[1],)
+    assert np.all(noise > 0)
+
+
+def test_an_unknown_noise_source_is_refused():
+    with pytest.raises(ValueError, match='noise_source'):
+        SlidingWindowDetector(noise_source='median').validate()

@@ -73,6 +73,41 @@ def robust_projection_reference(basis, columns):
     return fitted
 
 
+def projection_residual(basis, data, robust=True):
+    """
+    Return each window column's residual against its projection on the basis.
+
+    The residual the per-frame decision thresholds is a frame minus its
+    :func:`robust_projection`; this gives the window's own columns the same
+    residual, all columns at once (one small r x r system per column).
+
+    Parameters
+    ----------
+    basis : ndarray (C, n, r)
+        Orthonormal background basis of each channel (zero columns: unused).
+    data : ndarray (C, n, m)
+        The window's columns.
+    robust : bool
+        l1 fit by IRLS as :func:`robust_projection`; False: least squares.
+
+    """
+    residual = np.empty_like(data)
+    for channel in range(data.shape[0]):
+        used = np.any(basis[channel] != 0, axis=0)
+        b, d = basis[channel][:, used], data[channel]                # (n, r), (n, m)
+        coef = b.T @ d                                                # (r, m)
+        if robust:
+            rank = b.shape[1]
+            products = (b[:, :, None] * b[:, None, :]).reshape(b.shape[0], rank * rank)
+            for _ in range(_IRLS_SWEEPS):
+                weights = 1.0 / np.maximum(np.abs(d - b @ coef), 1e-3)
+                gram = (products.T @ weights).T.reshape(-1, rank, rank)      # (m, r, r)
+                right = (b.T @ (weights * d)).T[..., None]                  # (m, r, 1)
+                coef = np.linalg.solve(gram, right)[..., 0].T
+        residual[channel] = d - b @ coef
+    return residual
+
+
 def foreground_magnitude(columns, shape, model, buffered, mask_rule):
     """
     Return a frame's foreground magnitude (rows, cols) and the threshold to apply.

@@ -102,6 +102,7 @@ class WindowSnapshot:
     observed: np.ndarray = None  # (n, m) bool: entries holding the frame's own pixel; None: all
     first_column: int = None    # admission count of the oldest column (warm-start shift)
     decision: str = 'global'    # likewise the decision rule ('adaptive' needs pixel noise)
+    noise_source: str = 'solve'  # likewise the residual the pixel noise comes from
 
 
 @dataclass

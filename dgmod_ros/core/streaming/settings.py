@@ -8,6 +8,9 @@ import numpy as np
 
 from ..masks import MaskRule
 
+# Residuals the per-pixel noise level may come from (see window_solve.window_noise).
+NOISE_SOURCES = ('solve', 'projection', 'least_squares', 'max')
+
 
 def check_scale_and_color(scale, color):
     """Raise ``ValueError`` for a processing scale outside (0, 1] or an unknown colour mode."""
@@ -46,6 +49,9 @@ def check_window_parameters(detector):
     if detector.decision not in ('adaptive', 'uniform', 'global'):
         raise ValueError(f"decision must be 'adaptive', 'uniform' or 'global', "
                          f'got {detector.decision!r}')
+    if detector.noise_source not in NOISE_SOURCES:
+        raise ValueError(f'noise_source must be one of {NOISE_SOURCES}, '
+                         f'got {detector.noise_source!r}')
     if not (np.isfinite(detector.pixel_k) and detector.pixel_k > 0):
         raise ValueError(f'pixel_k must be positive, got {detector.pixel_k!r}')
     size = detector.median_size

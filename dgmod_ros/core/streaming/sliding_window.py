@@ -106,6 +106,12 @@ class SlidingWindowDetector(StreamingDetector):
         'adaptive': each pixel against ``pixel_k`` times its own noise level;
         'uniform': the same with the frame's typical noise level for all
         pixels; 'global': the ``mask_rule`` (one threshold, morphology).
+    noise_source : {'solve', 'projection', 'least_squares', 'max'}, default='solve'
+        The window residual each pixel's noise level is read from: the
+        solve's ``D - L``, each column against its robust or least-squares
+        projection on the fast path's basis (the distance the per-frame
+        decision thresholds), or the larger of the 'solve' and 'projection'
+        levels.
     pixel_k : float, default=6.0
         Multiple of the noise level that makes a pixel foreground ('adaptive',
         'uniform').
@@ -161,8 +167,8 @@ class SlidingWindowDetector(StreamingDetector):
     def __init__(self, model=None, window=30, stride=10, scale=0.5, color='rgb',
                  mask_rule=None, motion_threshold=0.0, min_frames=5, basis_rank=2,
                  global_change_fraction=0.7, memory_spacing=10, conditional_update=True,
-                 absorb_frames=300, decision='adaptive', pixel_k=6.0, median_size=5,
-                 ghost_test=True, still_frames=50, mrf_beta=2.0, chroma_cue=True,
+                 absorb_frames=300, decision='adaptive', noise_source='solve', pixel_k=6.0,
+                 median_size=5, ghost_test=True, still_frames=50, mrf_beta=2.0, chroma_cue=True,
                  texture_cue=True, texture_bits=8, solve_lag=0):
         self.model = model
         self.window = window
@@ -178,6 +184,7 @@ class SlidingWindowDetector(StreamingDetector):
         self.conditional_update = conditional_update
         self.absorb_frames = absorb_frames
         self.decision = decision
+        self.noise_source = noise_source
         self.pixel_k = pixel_k
         self.median_size = median_size
         self.ghost_test = ghost_test
@@ -447,7 +454,8 @@ class SlidingWindowDetector(StreamingDetector):
                               model=self.model_, mask_rule=self.mask_rule_,
                               basis_rank=int(self.basis_rank), ticket=self._ticket(),
                               observed=self.buffer_.observed(),
-                              first_column=self.buffer_.first_column, decision=self.decision)
+                              first_column=self.buffer_.first_column, decision=self.decision,
+                              noise_source=self.noise_source)
 
     def solve(self, snapshot):
         """

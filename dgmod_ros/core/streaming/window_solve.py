@@ -6,7 +6,7 @@ import time
 
 import numpy as np
 
-from .fast_path import background_basis
+from .fast_path import background_basis, projection_residual
 from .foreground import pixel_noise
 from .photometric import chroma_noise
 from .results import BackgroundModel, SolverFailure
@@ -35,6 +35,28 @@ def warm_starts(snapshot):
     return [state.shifted(shift) for state in previous.states]
 
 
+def window_noise(snapshot, residuals, basis):
+    """
+    Return each pixel's noise level from the residual ``snapshot.noise_source`` names.
+
+    'solve': the solve's ``D - L``; 'projection' / 'least_squares': each
+    column against its robust / least-squares projection on the fast path's
+    basis (the statistic the per-frame decision thresholds); 'max': the
+    larger of the 'solve' and 'projection' levels.
+    """
+    uniform = snapshot.decision == 'uniform'
+    source = snapshot.noise_source
+
+    def level(residual):
+        return pixel_noise(residual, snapshot.shape, snapshot.observed, uniform=uniform)
+
+    if source == 'solve':
+        return level(residuals)
+    projected = level(projection_residual(basis, snapshot.data,
+                                          robust=source != 'least_squares'))
+    return np.maximum(projected, level(residuals)) if source == 'max' else projected
+
+
 def solve_window(snapshot):
     """
     Separate a snapshot with its own estimator; read nothing else.
@@ -55,17 +77,16 @@ def solve_window(snapshot):
     backgrounds = separated.backgrounds
     if separated.diverged or not all(np.all(np.isfinite(b)) for b in backgrounds):
         raise SolverFailure('window solve produced non-finite values')
-    noise = chroma = None
-    if snapshot.decision != 'global':
-        uniform = snapshot.decision == 'uniform'
-        noise = pixel_noise(separated.residuals, snapshot.shape, snapshot.observed, uniform)
-        if channels == 3:
-            chroma = chroma_noise(snapshot.data, separated.residuals, snapshot.shape,
-                                  snapshot.observed, uniform)
     bases = [background_basis(b, int(snapshot.basis_rank)) for b in backgrounds]
     basis = np.zeros((channels, rows * cols, max(b.shape[1] for b in bases)), dtype=np.float32)
     for channel, channel_basis in enumerate(bases):
         basis[channel, :, :channel_basis.shape[1]] = channel_basis
+    noise = chroma = None
+    if snapshot.decision != 'global':
+        noise = window_noise(snapshot, separated.residuals, basis)
+        if channels == 3:
+            chroma = chroma_noise(snapshot.data, separated.residuals, snapshot.shape,
+                                  snapshot.observed, snapshot.decision == 'uniform')
     return BackgroundModel(
         basis=basis,
         background=np.stack([b[:, -1] for b in backgrounds], axis=1).reshape(
