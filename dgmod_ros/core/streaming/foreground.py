@@ -158,6 +158,22 @@ def _edge_strength(image):
     return np.abs(cv2.Sobel(image, cv2.CV_32F, 1, 0)) + np.abs(cv2.Sobel(image, cv2.CV_32F, 0, 1))
 
 
+def blob_motion(mask, frame, earlier, noise, k):
+    """
+    Return the 8-connected blobs of ``mask`` and the share of each that moved.
+
+    Returns ``(count, labels, moving_share)``: the number of labels (0 is the
+    background), the (rows, cols) labels, and per label the share of its pixels
+    whose frame differs from ``earlier`` by more than ``k`` noise levels.
+    """
+    count, labels = cv2.connectedComponents(mask, connectivity=8)
+    flat = labels.ravel()
+    moved = np.abs(frame - earlier).max(axis=0) > k * noise
+    moving_share = (np.bincount(flat, moved, minlength=count)
+                    / np.maximum(np.bincount(flat, minlength=count), 1))
+    return count, labels, moving_share
+
+
 def ghost_blobs(mask, frame, background, earlier, noise, k):
     """
     Return the pixels (rows, cols) bool of foreground blobs that are ghosts.
@@ -183,13 +199,9 @@ def ghost_blobs(mask, frame, background, earlier, noise, k):
 
     """
     rows, cols = mask.shape
-    count, labels = cv2.connectedComponents(mask, connectivity=8)
+    count, labels, moving_share = blob_motion(mask, frame, earlier, noise, k)
     if count <= 1:
         return np.zeros(mask.shape, dtype=bool)
-    flat = labels.ravel()
-    moved = np.abs(frame - earlier).max(axis=0) > k * noise
-    moving_share = (np.bincount(flat, moved, minlength=count)
-                    / np.maximum(np.bincount(flat, minlength=count), 1))
     border = cv2.morphologyEx(mask, cv2.MORPH_GRADIENT, np.ones((3, 3), np.uint8)) > 0
     # Border pixels just outside a blob take the blob's label from a 3 x 3 dilation.
     owner = cv2.dilate(labels.astype(np.float32), np.ones((3, 3), np.uint8))

@@ -24,8 +24,9 @@ which heals the background; a real object left behind and never touched
 (a bag) goes the same way, earlier than ``absorb_frames``.
 """
 
-import cv2
 import numpy as np
+
+from .foreground import blob_motion
 
 
 def still_blob_pixels(mask, frame, earlier, noise, k, share):
@@ -46,13 +47,9 @@ def still_blob_pixels(mask, frame, earlier, noise, k, share):
         Largest share of a blob's pixels that may change for the blob to be still.
 
     """
-    count, labels = cv2.connectedComponents(mask, connectivity=8)
+    count, labels, moving_share = blob_motion(mask, frame, earlier, noise, k)
     if count <= 1:
         return np.zeros(mask.shape, dtype=bool)
-    flat = labels.ravel()
-    moved = np.abs(frame - earlier).max(axis=0) > k * noise
-    moving_share = (np.bincount(flat, moved, minlength=count)
-                    / np.maximum(np.bincount(flat, minlength=count), 1))
     still = moving_share <= share
     still[0] = False
     return still[labels]
