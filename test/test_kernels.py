@@ -3,6 +3,10 @@
 """The fused numba sweep against the literal numpy sweep, and kernels from two threads."""
 
 import ctypes
+import os
+from pathlib import Path
+import subprocess
+import sys
 import threading
 
 from dgmod_ros.core import kernels
@@ -165,3 +169,24 @@ def test_openblas_runs_on_one_thread_after_a_fused_solve():
         pytest.skip('no OpenBLAS loaded (another BLAS: nothing to limit)')
     assert set(counts) == {1}
     assert limit_blas_threads(1) == len(counts)
+
+
+def test_threading_layer_survives_numba_imported_first(tmp_path):
+    # A module that imports numba before dgmod_ros.core.kernels, then a
+    # compile: numba re-reads its configuration from the environment, which
+    # must keep the threadsafe layer (the node calls kernels from two threads).
+    script = (
+        'import os\n'
+        'os.environ.pop("NUMBA_THREADING_LAYER", None)\n'
+        'os.environ.pop("NUMBA_CACHE_DIR", None)\n'
+        'import numba\n'
+        'from dgmod_ros.core import kernels\n'
+        '@numba.njit\n'
+        'def one_more(x):\n'
+        '    return x + 1\n'
+        'one_more(1)\n'
+        'print(numba.config.THREADING_LAYER)\n')
+    env = dict(os.environ, XDG_CACHE_HOME=str(tmp_path))
+    done = subprocess.run([sys.executable, '-c', script], capture_output=True, text=True,
+                          env=env, cwd=str(Path(__file__).resolve().parents[1]), check=True)
+    assert done.stdout.strip() == 'threadsafe'

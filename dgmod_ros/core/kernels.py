@@ -45,6 +45,10 @@ def default_cache_dir():
 
 if not os.environ.get('NUMBA_CACHE_DIR'):
     os.environ['NUMBA_CACHE_DIR'] = default_cache_dir()
+# Also in the environment: numba re-reads its whole configuration from the
+# environment when that changed since its import (the line above does, when
+# another module imported numba first), which would reset an attribute set alone.
+os.environ.setdefault('NUMBA_THREADING_LAYER', 'threadsafe')
 
 import numba  # noqa: E402 (the cache folder must be set before numba reads its config)
 from numba import njit, prange  # noqa: E402
