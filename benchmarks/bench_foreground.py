@@ -20,9 +20,9 @@ from dgmod_ros import config
 from dgmod_ros.core.preprocess import frame_columns
 from dgmod_ros.core.streaming.background_memory import conditional_columns
 from dgmod_ros.core.streaming.fast_path import projection_residual, robust_projection
-from dgmod_ros.core.streaming.foreground import (adaptive_mask, ghost_blobs, pixel_noise,
-                                                 to_input_size)
-from dgmod_ros.core.streaming.held_foreground import still_age, still_blob_pixels
+from dgmod_ros.core.streaming.foreground import (adaptive_mask, consecutive_frames, ghost_blobs,
+                                                 pixel_noise, to_input_size)
+from dgmod_ros.core.streaming.held_foreground import still_blob_pixels
 from dgmod_ros.core.streaming.photometric import chroma_noise
 from dgmod_ros.core.synthetic import synthetic_scene
 import numpy as np
@@ -68,7 +68,7 @@ def main():
         'lighting test (chroma, brightness, LBSP)': lambda: lighting.explains(
             columns, background, model.noise, k, shape, candidates, chroma_level),
         'ghost test': lambda: ghost_blobs(mask, columns, background, earlier, model.noise, k),
-        'still blobs (held foreground)': lambda: still_age(age, still_blob_pixels(
+        'still blobs (held foreground)': lambda: consecutive_frames(age, still_blob_pixels(
             mask, columns, earlier, model.noise, k / 2, 0.01)),
         'mask to input size': lambda: to_input_size(mask, detector.input_shape_),
         'conditional admission (when due)': lambda: conditional_columns(

@@ -5,8 +5,8 @@
 from dgmod_ros.core.streaming import SlidingWindowDetector
 from dgmod_ros.core.streaming.coherence import mean_field_mask
 from dgmod_ros.core.streaming.fast_path import projection_residual, robust_projection
-from dgmod_ros.core.streaming.foreground import warmup_noise
-from dgmod_ros.core.streaming.held_foreground import still_age, still_blob_pixels
+from dgmod_ros.core.streaming.foreground import consecutive_frames, warmup_noise
+from dgmod_ros.core.streaming.held_foreground import still_blob_pixels
 import numpy as np
 import pytest
 
@@ -60,13 +60,13 @@ def test_still_blob_pixels_of_an_empty_mask_is_empty():
     assert not still_blob_pixels(mask, columns, columns, 0.01, 3.0, 0.01).any()
 
 
-def test_still_age_counts_consecutive_still_frames_and_restarts():
-    age = still_age(None, np.array([True, False, True]))
-    age = still_age(age, np.array([True, True, False]))
+def test_consecutive_frames_counts_and_restarts():
+    age = consecutive_frames(None, np.array([True, False, True]))
+    age = consecutive_frames(age, np.array([True, True, False]))
     assert age.tolist() == [2, 1, 0]
     assert age.dtype == np.int32
     # A new size (the scale changed) starts over.
-    assert still_age(age, np.array([True, True])).tolist() == [1, 1]
+    assert consecutive_frames(age, np.array([True, True])).tolist() == [1, 1]
 
 
 def _box_scene(ghost, frames=150, change=40):

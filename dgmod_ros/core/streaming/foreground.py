@@ -158,6 +158,19 @@ def _edge_strength(image):
     return np.abs(cv2.Sobel(image, cv2.CV_32F, 1, 0)) + np.abs(cv2.Sobel(image, cv2.CV_32F, 0, 1))
 
 
+def consecutive_frames(previous, flags):
+    """
+    Return for each pixel the consecutive frames (n,) int32 its flag has held.
+
+    ``previous`` is the count of the frame before (None or another shape:
+    start from zero); a pixel whose flag is off restarts at 0.
+    """
+    flags = np.asarray(flags).ravel()
+    if previous is None or previous.shape != flags.shape:
+        previous = np.zeros(flags.shape, dtype=np.int32)
+    return np.where(flags, previous + 1, 0).astype(np.int32)
+
+
 def blob_motion(mask, frame, earlier, noise, k):
     """
     Return the 8-connected blobs of ``mask`` and the share of each that moved.

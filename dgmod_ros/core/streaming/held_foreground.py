@@ -53,11 +53,3 @@ def still_blob_pixels(mask, frame, earlier, noise, k, share):
     still = moving_share <= share
     still[0] = False
     return still[labels]
-
-
-def still_age(previous, still):
-    """Return the consecutive frames (n,) int32 each pixel has been in a still blob."""
-    still = np.asarray(still).ravel()
-    if previous is None or previous.shape != still.shape:
-        previous = np.zeros(still.shape, dtype=np.int32)
-    return np.where(still, previous + 1, 0).astype(np.int32)

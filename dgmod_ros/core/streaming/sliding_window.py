@@ -16,8 +16,9 @@ from .background_memory import BackgroundMemory, conditional_columns
 from .buffer import SceneChangeWatch
 from .contract import StreamingDetector
 from .fast_path import robust_projection
-from .foreground import adaptive_mask, ghost_blobs, to_input_size, warmup_noise
-from .held_foreground import still_age, still_blob_pixels
+from .foreground import (adaptive_mask, consecutive_frames, ghost_blobs, to_input_size,
+                         warmup_noise)
+from .held_foreground import still_blob_pixels
 from .photometric import LightingTest
 from .results import FrameResult, WindowSnapshot
 from .settings import assign_validated, check_window_parameters
@@ -355,16 +356,12 @@ class SlidingWindowDetector(StreamingDetector):
         """Clear, in place, the pixels of ``foreground`` held still for ``still_frames``."""
         still = still_blob_pixels(foreground, columns, self.recent_[0][1], level,
                                   self.pixel_k / 2, _STILL_SHARE)
-        self.still_age_ = still_age(self.still_age_, still)
+        self.still_age_ = consecutive_frames(self.still_age_, still)
         foreground[self.still_age_.reshape(foreground.shape) >= self.still_frames] = 0
 
     def _admit(self, columns, background, foreground, frame_id):
         """Put the frame into the window if due (conditionally); return whether it went in."""
-        is_foreground = foreground.ravel() > 0
-        age = self.foreground_age_
-        if age is None or age.shape != is_foreground.shape:
-            age = np.zeros(is_foreground.shape, dtype=np.int32)
-        self.foreground_age_ = np.where(is_foreground, age + 1, 0).astype(np.int32)
+        self.foreground_age_ = consecutive_frames(self.foreground_age_, foreground > 0)
         if (not self.buffer_.wants(frame_id)
                 or self.buffer_.is_motionless(columns, self.motion_threshold)):
             return False
