@@ -95,11 +95,14 @@ def main():
     # (grey projection on one channel's basis, one threshold, 3 x 3 morphology).
     grey, _ = frame_columns(frame, detector.scale, 'gray', 'rgb', None)
     rule = detector.mask_rule_
+    # A model solved for the per-pixel decision carries no global threshold;
+    # the detector's own fallback gives one from the noise levels.
+    threshold = rule.threshold_from_noise(model.noise)
 
     def earlier_path():
         residual = grey - robust_projection(model.basis[1:2], grey)
         magnitude = np.abs(residual).max(axis=0).reshape(shape[:2])
-        rule.apply(magnitude, model.threshold, detector.input_shape_)
+        rule.apply(magnitude, threshold, detector.input_shape_)
 
     print(f'  {"reference: earlier grey path, same run":45s} '
           f'{median_ms(earlier_path, args.repeats):7.2f} ms per frame')
