@@ -100,38 +100,9 @@ def projection_residual(basis, data, robust=True):
             rank = b.shape[1]
             products = (b[:, :, None] * b[:, None, :]).reshape(b.shape[0], rank * rank)
             for _ in range(_IRLS_SWEEPS):
-                weights = 1.0 / np.maximum(np.abs(d - b @ coef), 1e-3)
+                weights = 1.0 / np.maximum(np.abs(d - b @ coef), _IRLS_FLOOR)
                 gram = (products.T @ weights).T.reshape(-1, rank, rank)      # (m, r, r)
                 right = (b.T @ (weights * d)).T[..., None]                  # (m, r, 1)
                 coef = np.linalg.solve(gram, right)[..., 0].T
         residual[channel] = d - b @ coef
     return residual
-
-
-def foreground_magnitude(columns, shape, model, buffered, mask_rule):
-    """
-    Return a frame's foreground magnitude (rows, cols) and the threshold to apply.
-
-    Parameters
-    ----------
-    columns : ndarray (C, n)
-        The frame at the processing size.
-    shape : tuple (rows, cols, C)
-        Processing shape.
-    model : BackgroundModel or None
-        The last installed solve; None while warming up.
-    buffered : ndarray (C, n, m)
-        The buffered frames (used while warming up).
-    mask_rule : MaskRule
-        Estimates the warm-up threshold.
-
-    """
-    rows, cols, _ = shape
-    if model is None:
-        background = np.median(buffered, axis=2)
-        residual = columns - background
-        threshold = mask_rule.estimate_threshold(residual, buffered)
-    else:
-        residual = columns - robust_projection(model.basis, columns)
-        threshold = model.threshold
-    return np.abs(residual).max(axis=0).reshape(rows, cols), threshold
