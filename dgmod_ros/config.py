@@ -136,6 +136,12 @@ PARAMETERS = (
               'one (adaptive, uniform)'),
     Parameter('texture_bits', 8, 'largest LBSP Hamming distance (of 16 bits per channel) of a '
               'change of light', 0, 48),
+    Parameter('moving_texture_k', 3.0, 'pixels whose LBSP texture changed (moving_texture_bits '
+              'or more) and that moved over 5 frames are foreground from this multiple of the '
+              'noise level instead of pixel_k (a person whose colour matches what is behind); '
+              '0 = off (adaptive, uniform)', 0.0, 100.0),
+    Parameter('moving_texture_bits', 12, 'fewest differing LBSP bits (of 16 per channel) of a '
+              'changed texture for moving_texture_k', 0, 48),
     Parameter('mask_threshold', 0.0, 'fixed threshold on |S| for data in [0, 1]; 0 = auto '
               '(max(mask_min_threshold, mask_k * robust sigma of D - L))', 0.0, 1.0),
     Parameter('mask_k', 5.0, 'multiple of the robust noise level of the auto threshold',
@@ -259,6 +265,8 @@ def detector_settings(values):
             'ghost_test': values['ghost_test'], 'still_frames': values['still_frames'],
             'mrf_beta': values['mrf_beta'], 'chroma_cue': values['chroma_cue'],
             'texture_cue': values['texture_cue'], 'texture_bits': values['texture_bits'],
+            'moving_texture_k': values['moving_texture_k'],
+            'moving_texture_bits': values['moving_texture_bits'],
             'solve_lag': values['solve_lag']}
 
 

@@ -5,7 +5,8 @@
 from dgmod_ros.core.streaming import SlidingWindowDetector
 from dgmod_ros.core.streaming.coherence import mean_field_mask
 from dgmod_ros.core.streaming.fast_path import projection_residual, robust_projection
-from dgmod_ros.core.streaming.foreground import consecutive_frames, warmup_noise
+from dgmod_ros.core.streaming.foreground import (adaptive_mask, consecutive_frames,
+                                                 moving_texture_k, warmup_noise)
 from dgmod_ros.core.streaming.held_foreground import still_blob_pixels
 import numpy as np
 import pytest
@@ -136,6 +137,66 @@ def test_mean_field_fills_a_weak_pixel_inside_a_silhouette():
     assert mask[9, 13]
     assert mask[4:16, 10:18].all()
     assert mask.sum() == 12 * 8
+
+
+def test_mean_field_takes_each_pixels_own_k():
+    z = np.random.default_rng(2).uniform(0, 12, (20, 30)).astype(np.float32)
+    k = np.where(np.arange(z.size) % 2 == 0, 3.0, 6.0).astype(np.float32)
+    mask = mean_field_mask(z.ravel() * 0.01, 0.01, k, 0.0, (20, 30, 3)) > 0
+    assert np.array_equal(mask.ravel(), z.ravel() > k)
+    assert np.array_equal(mean_field_mask(z.ravel() * 0.01, 0.01, np.full(z.size, 6.0), 2.0,
+                                          (20, 30, 3)), _field(z, 2.0))
+
+
+def _patch_scene(amplitude, noise, checker=True, moved=True):
+    """Return frame, background, earlier (3, n) of a flat grey wall with a 12 x 12 patch."""
+    rows, cols = 32, 40
+    background = np.full((3, rows, cols), 0.5, np.float32)
+    frame = background.copy()
+    sign = np.where((np.add.outer(np.arange(12), np.arange(12)) // 2) % 2 == 0, 1.0, -1.0)
+    frame[:, 10:22, 14:26] += amplitude * (sign if checker else 1.0)
+    earlier = background if moved else frame
+    return (frame.reshape(3, -1), background.reshape(3, -1), earlier.reshape(3, -1),
+            np.full(rows * cols, noise, np.float32), (rows, cols, 3))
+
+
+def _patch(image):
+    return np.reshape(image, (32, 40))[12:20, 16:24]
+
+
+def test_moving_texture_lowers_k_where_the_pattern_changed_and_moved():
+    # A shaded pattern of 5 noise levels, beyond LBSP's relative threshold, that moved.
+    frame, background, earlier, noise, shape = _patch_scene(0.25, 0.05)
+    factor = moving_texture_k(frame, background, earlier, noise, 6.0, 3.0, 12, shape)
+    assert np.all(_patch(factor) == 3.0)
+    assert np.count_nonzero(factor == 3.0) <= 12 * 12
+    mask, _ = adaptive_mask(frame, background, noise, 6.0, shape, 5, 2.0, earlier=earlier,
+                            weak_k=3.0)
+    assert _patch(mask).all()
+    off, _ = adaptive_mask(frame, background, noise, 6.0, shape, 5, 2.0, earlier=earlier,
+                           weak_k=0.0)
+    assert not off.any()
+
+
+def test_moving_texture_needs_motion():
+    frame, background, earlier, noise, shape = _patch_scene(0.25, 0.05, moved=False)
+    assert np.all(moving_texture_k(frame, background, earlier, noise, 6.0, 3.0, 12,
+                                   shape) == 6.0)
+
+
+def test_moving_texture_needs_a_change_beyond_the_relative_threshold():
+    # 5 noise levels but a tenth of the value: light's share, no pattern of its own.
+    frame, background, earlier, noise, shape = _patch_scene(0.05, 0.01, checker=False)
+    assert np.all(moving_texture_k(frame, background, earlier, noise, 6.0, 3.0, 12,
+                                   shape) == 6.0)
+
+
+@pytest.mark.parametrize('name, value', [('moving_texture_k', -1.0),
+                                         ('moving_texture_bits', 49),
+                                         ('moving_texture_bits', 2.5)])
+def test_bad_moving_texture_parameters_are_refused(name, value):
+    with pytest.raises(ValueError, match=name):
+        SlidingWindowDetector(**{name: value}).validate()
 
 
 def _window_on_a_basis(seed=1, pixels=400, frames=6):

@@ -56,8 +56,9 @@ def mean_field_mask(distance, noise, k, beta, shape, sweeps=SWEEPS, radius=RADIU
         Each pixel's distance to its background.
     noise : ndarray (n,) or float
         Each pixel's noise level.
-    k : float
-        Multiple of the noise level at which a pixel alone is even odds.
+    k : float or ndarray (n,)
+        Multiple of the noise level at which a pixel alone is even odds
+        (one for all pixels or each pixel's own).
     beta : float
         Coupling of neighbours (log-odds per neighbour); 0 gives the plain rule.
     shape : tuple (rows, cols, ...)
@@ -69,8 +70,9 @@ def mean_field_mask(distance, noise, k, beta, shape, sweeps=SWEEPS, radius=RADIU
 
     """
     rows, cols = shape[:2]
-    z = np.minimum(np.reshape(distance, -1) / noise, _Z_CAP * k).reshape(rows, cols)
-    unary = ((z * z - k * k) / 2).astype(np.float32)
+    k = np.reshape(np.asarray(k, dtype=np.float32), -1)
+    z = np.minimum(np.reshape(distance, -1) / noise, _Z_CAP * k)
+    unary = ((z * z - k * k) / 2).astype(np.float32).reshape(rows, cols)
     side = 2 * int(radius) + 1
     spin = np.where(unary > 0, np.float32(1), np.float32(-1))      # the plain rule
     for _ in range(int(sweeps)):

@@ -65,6 +65,11 @@ def check_window_parameters(detector):
     bits = detector.texture_bits
     if int(bits) != bits or not 0 <= bits <= 48:
         raise ValueError(f'texture_bits must be an integer in [0, 48], got {bits!r}')
+    if not (np.isfinite(detector.moving_texture_k) and detector.moving_texture_k >= 0):
+        raise ValueError(f'moving_texture_k must be >= 0, got {detector.moving_texture_k!r}')
+    bits = detector.moving_texture_bits
+    if int(bits) != bits or not 0 <= bits <= 48:
+        raise ValueError(f'moving_texture_bits must be an integer in [0, 48], got {bits!r}')
     lag = detector.solve_lag
     if int(lag) != lag or not 0 <= lag <= stride:
         raise ValueError(f'solve_lag must be an integer in [0, stride={stride}], got {lag!r}')

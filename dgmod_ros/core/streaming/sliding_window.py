@@ -143,6 +143,15 @@ class SlidingWindowDetector(StreamingDetector):
         candidate.
     texture_bits : int, default=8
         Largest LBSP Hamming distance of a change of light.
+    moving_texture_k : float, default=3.0
+        > 0: a pixel whose LBSP texture differs from the background's in at
+        least ``moving_texture_bits`` bits and that changed against the frame
+        5 frames before is foreground from this multiple of its noise level
+        instead of ``pixel_k`` ('adaptive', 'uniform'; see
+        :func:`~dgmod_ros.core.streaming.foreground.moving_texture_k`); 0
+        disables.
+    moving_texture_bits : int, default=12
+        Fewest differing LBSP bits of a changed texture.
     solve_lag : int, default=0
         Frames between a solve's snapshot and its install (at most
         ``stride``): the solve of the window taken at frame ``t`` becomes the
@@ -170,7 +179,8 @@ class SlidingWindowDetector(StreamingDetector):
                  global_change_fraction=0.7, memory_spacing=10, conditional_update=True,
                  absorb_frames=300, decision='adaptive', noise_source='solve', pixel_k=6.0,
                  median_size=5, ghost_test=True, still_frames=50, mrf_beta=2.0, chroma_cue=True,
-                 texture_cue=True, texture_bits=8, solve_lag=0):
+                 texture_cue=True, texture_bits=8, moving_texture_k=3.0, moving_texture_bits=12,
+                 solve_lag=0):
         self.model = model
         self.window = window
         self.stride = stride
@@ -194,6 +204,8 @@ class SlidingWindowDetector(StreamingDetector):
         self.chroma_cue = chroma_cue
         self.texture_cue = texture_cue
         self.texture_bits = texture_bits
+        self.moving_texture_k = moving_texture_k
+        self.moving_texture_bits = moving_texture_bits
         self.solve_lag = solve_lag
         self._validated = False
 
@@ -325,17 +337,20 @@ class SlidingWindowDetector(StreamingDetector):
             changed = result.mask
         else:
             model = self.background_model_
+            earlier = (self.recent_[0][1] if len(self.recent_) == self.recent_.maxlen
+                       else None)
             foreground, result.magnitude = adaptive_mask(
                 columns, background, level, self.pixel_k, self.shape_, self.median_size,
                 self.mrf_beta, self.lighting_,
-                model.chroma_noise if model is not None else None)
+                model.chroma_noise if model is not None else None, earlier,
+                self.moving_texture_k, int(self.moving_texture_bits))
             # The scene-change rule counts every change, light included: after
             # the lights of most of the view switch, the lighting test would
             # hide the change while the window still holds the old light.
             changed = result.magnitude.ravel() > self.pixel_k * level
             if (self.ghost_test and self.background_model_ is not None
-                    and len(self.recent_) == self.recent_.maxlen):
-                ghosts = ghost_blobs(foreground, columns, background, self.recent_[0][1],
+                    and earlier is not None):
+                ghosts = ghost_blobs(foreground, columns, background, earlier,
                                      level, self.pixel_k)
                 foreground[ghosts] = 0
             if (self.still_frames and self.background_model_ is not None
