@@ -21,7 +21,7 @@ from dgmod_ros.core.preprocess import frame_columns
 from dgmod_ros.core.streaming.background_memory import conditional_columns
 from dgmod_ros.core.streaming.fast_path import projection_residual, robust_projection
 from dgmod_ros.core.streaming.foreground import (adaptive_mask, consecutive_frames, ghost_blobs,
-                                                 pixel_noise, to_input_size)
+                                                 moving_texture_k, pixel_noise, to_input_size)
 from dgmod_ros.core.streaming.held_foreground import still_blob_pixels
 from dgmod_ros.core.streaming.photometric import chroma_noise
 from dgmod_ros.core.synthetic import synthetic_scene
@@ -54,6 +54,7 @@ def main():
     # A person near the camera: a quarter of the view (the test's cost follows the candidates).
     quarter = np.arange(candidates.size) < candidates.size // 4
     earlier = detector.recent_[0][1]
+    weak_k, weak_bits = detector.moving_texture_k, int(detector.moving_texture_bits)
     snapshot = detector.snapshot()
     residual = snapshot.data - snapshot.data.mean(axis=2, keepdims=True)
     age = detector.foreground_age_
@@ -67,6 +68,9 @@ def main():
             detector.mrf_beta),
         'lighting test (chroma, brightness, LBSP)': lambda: lighting.explains(
             columns, background, model.noise, k, shape, candidates, chroma_level),
+        'moving texture (LBSP at weak moving pixels)': lambda: moving_texture_k(
+            columns, background, earlier, model.noise, k, weak_k, weak_bits, shape,
+            distance.ravel()),
         'ghost test': lambda: ghost_blobs(mask, columns, background, earlier, model.noise, k),
         'still blobs (held foreground)': lambda: consecutive_frames(age, still_blob_pixels(
             mask, columns, earlier, model.noise, k / 2, 0.01)),
@@ -90,6 +94,12 @@ def main():
     quarter_ms = median_ms(lambda: lighting.explains(columns, background, model.noise, k, shape,
                                                      quarter, chroma_level), args.repeats)
     print(f'  {"lighting test, a quarter of the view candidate":45s} {quarter_ms:7.2f} '
+          'ms per frame')
+    # Every pixel weak and moving: the moving-texture rule's LBSP over the whole view.
+    everywhere_ms = median_ms(lambda: moving_texture_k(
+        columns, background, earlier, model.noise, np.inf, 0.0, weak_bits, shape,
+        distance.ravel()), args.repeats)
+    print(f'  {"moving texture, every pixel weak (worst case)":45s} {everywhere_ms:7.2f} '
           'ms per frame')
     # The earlier default per-frame path in the same run, as the reference
     # (grey projection on one channel's basis, one threshold, 3 x 3 morphology).
