@@ -140,7 +140,7 @@ PARAMETERS = (
               'or more) and that moved over 5 frames are foreground from this multiple of the '
               'noise level instead of pixel_k (a person whose colour matches what is behind); '
               '0 = off (adaptive, uniform)', 0.0, 100.0),
-    Parameter('moving_texture_bits', 12, 'fewest differing LBSP bits (of 16 per channel) of a '
+    Parameter('moving_texture_bits', 16, 'fewest differing LBSP bits (of 16 per channel) of a '
               'changed texture for moving_texture_k', 0, 48),
     Parameter('mask_threshold', 0.0, 'fixed threshold on |S| for data in [0, 1]; 0 = auto '
               '(max(mask_min_threshold, mask_k * robust sigma of D - L))', 0.0, 1.0),

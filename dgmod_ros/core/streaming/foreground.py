@@ -156,7 +156,7 @@ def moving_texture_k(columns, background, earlier, noise, k, weak_k, min_bits, s
 
 
 def adaptive_mask(columns, background, noise, k, shape, median_size, mrf_beta=0.0,
-                  lighting=None, chroma_level=None, earlier=None, weak_k=0.0, weak_bits=12):
+                  lighting=None, chroma_level=None, earlier=None, weak_k=0.0, weak_bits=16):
     """
     Return a frame's foreground at the processing size (uint8 0/255) and its distance.
 

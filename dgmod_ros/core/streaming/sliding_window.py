@@ -150,7 +150,7 @@ class SlidingWindowDetector(StreamingDetector):
         instead of ``pixel_k`` ('adaptive', 'uniform'; see
         :func:`~dgmod_ros.core.streaming.foreground.moving_texture_k`); 0
         disables.
-    moving_texture_bits : int, default=12
+    moving_texture_bits : int, default=16
         Fewest differing LBSP bits of a changed texture.
     solve_lag : int, default=0
         Frames between a solve's snapshot and its install (at most
@@ -179,7 +179,7 @@ class SlidingWindowDetector(StreamingDetector):
                  global_change_fraction=0.7, memory_spacing=10, conditional_update=True,
                  absorb_frames=300, decision='adaptive', noise_source='solve', pixel_k=6.0,
                  median_size=5, ghost_test=True, still_frames=50, mrf_beta=2.0, chroma_cue=True,
-                 texture_cue=True, texture_bits=8, moving_texture_k=3.0, moving_texture_bits=12,
+                 texture_cue=True, texture_bits=8, moving_texture_k=3.0, moving_texture_bits=16,
                  solve_lag=0):
         self.model = model
         self.window = window
