@@ -17,15 +17,17 @@ fixes its share of each, wherever the solve did not call that pixel foreground.
 import cv2
 import numpy as np
 
+from .foreground import pixel_noise
 from ..linalg import thin_svd
 
 # Most channels one cv2.resize call takes: OpenCV 5's CV_CN_MAX, and 4 for
 # area averaging at a ratio that is not an integer.
 _RESIZE_CHANNELS = {cv2.INTER_AREA: 4}
 _MAX_CHANNELS = 128
-# Smallest |S| of the solve that holds an entry out of the full-size fit: one
-# grey level of 8-bit data (below it, S holds noise, which the fit may keep).
-_FOREGROUND_FLOOR = 1.0 / 255.0
+# Noise levels of the solve's residual above which an entry is held out of the
+# full-size fit (a short solve's S holds much of the noise too, so S's own
+# support would hold out nearly every entry).
+_HELD_OUT_SIGMAS = 3.0
 
 
 def solve_shape(shape, max_pixels):
@@ -71,7 +73,7 @@ def downsample_window(data, shape, small_shape):
                      for channel in data])
 
 
-def carry_backgrounds(data, shape, backgrounds, foregrounds, small_shape, rank):
+def carry_backgrounds(data, shape, backgrounds, small_residuals, small_shape, rank):
     """
     Return the full-size backgrounds of a window solved at ``small_shape``, and ``D - L``.
 
@@ -79,8 +81,10 @@ def carry_backgrounds(data, shape, backgrounds, foregrounds, small_shape, rank):
     the full-size detail it lacks: each pixel's residual time series against
     the upsampled ``L``, fitted by weighted least squares on the solve's
     leading ``rank`` temporal factors ``V`` (m x r, orthonormal), with the
-    entries the solve called foreground (``|S| >= 1/255`` in any channel,
-    upsampled) weighted out. Zero detail counts as a tenth of an observed
+    entries the solve called foreground weighted out: those whose residual
+    ``D - L`` (largest over the channels) exceeds three times the pixel's
+    noise level (:func:`~dgmod_ros.core.streaming.foreground.pixel_noise` of
+    that residual), upsampled, any overlap counting. Zero detail counts as a tenth of an observed
     frame (a ridge of ``0.1/m``: it shrinks a fully observed pixel's detail
     by 0.3% at m = 30, and keeps the system of a pixel seen in fewer than r
     frames solvable, that pixel keeping the upsampled ``L``). A pixel with
@@ -93,8 +97,10 @@ def carry_backgrounds(data, shape, backgrounds, foregrounds, small_shape, rank):
         The window at full size.
     shape, small_shape : tuple (rows, cols, ...)
         Full and solve frame sizes.
-    backgrounds, foregrounds : list of ndarray (n_small, m)
-        The solve's ``L`` and ``S`` of each channel.
+    backgrounds : list of ndarray (n_small, m)
+        The solve's ``L`` of each channel.
+    small_residuals : ndarray (C, n_small, m)
+        The solve's ``D - L``.
     rank : int
         Temporal factors carried (the fast path's ``basis_rank``).
 
@@ -104,9 +110,10 @@ def carry_backgrounds(data, shape, backgrounds, foregrounds, small_shape, rank):
     residuals : ndarray (C, n, m) float32
 
     """
-    magnitude = np.max([np.abs(s) for s in foregrounds], axis=0)
-    held_out = resample_columns(magnitude, small_shape, shape, cv2.INTER_LINEAR)
-    held_out = held_out >= _FOREGROUND_FLOOR
+    magnitude = np.abs(small_residuals).max(axis=0)                       # (n_small, m)
+    noise = pixel_noise(small_residuals, small_shape)
+    held_out = (magnitude > _HELD_OUT_SIGMAS * noise[:, None]).astype(np.float32)
+    held_out = resample_columns(held_out, small_shape, shape, cv2.INTER_LINEAR) > 0
     partial = np.flatnonzero(held_out.any(axis=1))          # pixels with an entry out
     weights = (~held_out[partial]).astype(np.float32)        # (k, m)
     ridge = 0.1 / data.shape[2]

@@ -96,7 +96,7 @@ def solve_window(snapshot):
         raise SolverFailure('window solve produced non-finite values')
     if carried:
         backgrounds, residuals = carry_backgrounds(
-            snapshot.data, snapshot.shape, backgrounds, separated.foregrounds, small_shape,
+            snapshot.data, snapshot.shape, backgrounds, residuals, small_shape,
             snapshot.basis_rank)
     bases = [background_basis(b, int(snapshot.basis_rank)) for b in backgrounds]
     basis = np.zeros((channels, rows * cols, max(b.shape[1] for b in bases)), dtype=np.float32)
