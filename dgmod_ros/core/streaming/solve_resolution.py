@@ -77,19 +77,20 @@ def carry_backgrounds(data, shape, backgrounds, small_residuals, small_shape, ra
     """
     Return the full-size backgrounds of a window solved at ``small_shape``, and ``D - L``.
 
-    Each channel's full-size background is the solve's ``L`` upsampled plus
-    the full-size detail it lacks: each pixel's residual time series against
-    the upsampled ``L``, fitted by weighted least squares on the solve's
-    leading ``rank`` temporal factors ``V`` (m x r, orthonormal), with the
-    entries the solve called foreground weighted out: those whose residual
-    ``D - L`` (largest over the channels) exceeds three times the pixel's
-    noise level (:func:`~dgmod_ros.core.streaming.foreground.pixel_noise` of
-    that residual), upsampled, any overlap counting. Zero detail counts as a tenth of an observed
+    Each channel's full-size background is ``A V^T``: ``V`` (m x r,
+    orthonormal) the solve's leading ``rank`` temporal factors, and each
+    full-size pixel's row of ``A`` the weighted least-squares fit of its own
+    time series on ``V``, starting from the solve's ``L V`` upsampled (``P``).
+    The entries the solve called foreground are weighted out: those whose
+    residual ``D - L`` (largest over the channels) exceeds three times the
+    pixel's noise level (:func:`~dgmod_ros.core.streaming.foreground.pixel_noise`
+    of that residual), upsampled, any overlap counting. The fit is of the
+    detail ``D - P V^T``, and zero detail counts as a tenth of an observed
     frame (a ridge of ``0.1/m``: it shrinks a fully observed pixel's detail
     by 0.3% at m = 30, and keeps the system of a pixel seen in fewer than r
-    frames solvable, that pixel keeping the upsampled ``L``). A pixel with
-    every entry in has ``V^T V = I`` for its r x r matrix; only the others
-    solve theirs (batched).
+    frames solvable, that pixel keeping the solve's background). A pixel with
+    every entry in has ``V^T V = I`` for its r x r matrix, so its fit is
+    ``D V - P``; only the others solve theirs (batched).
 
     Parameters
     ----------
@@ -113,25 +114,23 @@ def carry_backgrounds(data, shape, backgrounds, small_residuals, small_shape, ra
     magnitude = np.abs(small_residuals).max(axis=0)                       # (n_small, m)
     noise = pixel_noise(small_residuals, small_shape)
     held_out = (magnitude > _HELD_OUT_SIGMAS * noise[:, None]).astype(np.float32)
-    held_out = resample_columns(held_out, small_shape, shape, cv2.INTER_LINEAR) > 0
-    partial = np.flatnonzero(held_out.any(axis=1))          # pixels with an entry out
-    weights = (~held_out[partial]).astype(np.float32)        # (k, m)
+    held_out = resample_columns(held_out, small_shape, shape, cv2.INTER_LINEAR)
+    partial = np.flatnonzero(held_out.max(axis=1) > 0)      # pixels with an entry out
+    weights = (held_out[partial] == 0).astype(np.float32)    # (k, m)
     ridge = 0.1 / data.shape[2]
     full = []
     residuals = np.empty_like(data)
     for channel, small in enumerate(backgrounds):
         _, _, temporal = thin_svd(small, int(rank))                       # (m, r)
         r = temporal.shape[1]
-        background = resample_columns(small, small_shape, shape, cv2.INTER_LINEAR)
-        detail = np.subtract(data[channel], background, out=residuals[channel])
-        detail[held_out] = 0.0
-        right = detail @ temporal                                         # (n, r)
-        coef = right / np.float32(1.0 + ridge)
+        start = resample_columns(small @ temporal, small_shape, shape, cv2.INTER_LINEAR)
+        coef = (data[channel] @ temporal - start) / np.float32(1.0 + ridge)
         if partial.size:
+            detail = (data[channel][partial] - start[partial] @ temporal.T) * weights
             outer = (temporal[:, :, None] * temporal[:, None, :]).reshape(-1, r * r)
             gram = (weights @ outer).reshape(-1, r, r) + ridge * np.eye(r, dtype=np.float32)
-            coef[partial] = np.linalg.solve(gram, right[partial][:, :, None])[:, :, 0]
-        background = (background @ temporal + coef) @ temporal.T
+            coef[partial] = np.linalg.solve(gram, (detail @ temporal)[:, :, None])[:, :, 0]
+        background = (start + coef) @ temporal.T
         np.subtract(data[channel], background, out=residuals[channel])
         full.append(background)
     return full, residuals
