@@ -35,7 +35,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--repeats', type=int, default=30)
     parser.add_argument('--set', action='append', default=[], metavar='NAME=VALUE',
-                        help='a parameter other than its default (the node\'s name and type)')
+                        help="a parameter other than its default (the node's name and type)")
     args = parser.parse_args()
     values = dict(config.DEFAULTS)
     for item in args.set:

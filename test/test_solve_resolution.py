@@ -2,6 +2,7 @@
 # Licensed under the Apache License, Version 2.0
 """The window solve at a capped size and the full-size background carried from it."""
 
+import cv2
 from dgmod_ros import config
 from dgmod_ros.core.dgmod import DualGraphMOD
 from dgmod_ros.core.masks import MaskRule
@@ -11,7 +12,6 @@ from dgmod_ros.core.streaming.solve_resolution import (downsample_window, resamp
                                                        solve_shape)
 from dgmod_ros.core.streaming.window_solve import solve_window
 from dgmod_ros.core.synthetic import synthetic_scene
-import cv2
 import numpy as np
 import pytest
 

@@ -118,7 +118,8 @@ def solve_window(snapshot):
         # per-pixel decisions read ``noise`` instead.
         threshold=(snapshot.mask_rule.estimate_threshold(residuals, snapshot.data)
                    if snapshot.decision == 'global' else None),
-        shape=snapshot.shape, solve_shape=small_shape, first_id=snapshot.first_id, last_id=snapshot.last_id,
+        shape=snapshot.shape, first_id=snapshot.first_id, last_id=snapshot.last_id,
         states=separated.states, seconds=time.perf_counter() - started,
         iterations=separated.iterations, info=separated.info, ticket=snapshot.ticket,
-        noise=noise, first_column=snapshot.first_column, chroma_noise=chroma)
+        noise=noise, first_column=snapshot.first_column, chroma_noise=chroma,
+        solve_shape=small_shape)
