@@ -11,6 +11,7 @@ share per frame. Prints figures; asserts nothing.
 Usage::
 
     PYTHONPATH=. .venv/bin/python benchmarks/bench_foreground.py [--repeats 30]
+        [--set scale=1.0 ...]
 """
 
 import argparse
@@ -33,8 +34,13 @@ def main():
     """Run the detector to a full window, then time each stage."""
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--repeats', type=int, default=30)
+    parser.add_argument('--set', action='append', default=[], metavar='NAME=VALUE',
+                        help="a parameter other than its default (the node's name and type)")
     args = parser.parse_args()
     values = dict(config.DEFAULTS)
+    for item in args.set:
+        name, text = item.split('=', 1)
+        values[name] = type(config.DEFAULTS[name])(text)
     detector = config.build_detector(values)
     scene = synthetic_scene(n_frames=60, shape=(480, 640), seed=3)
     frames = list(scene.frames) * 6                      # 360 frames: the window fills up

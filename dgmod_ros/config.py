@@ -50,8 +50,9 @@ PARAMETERS = (
                        'knn')),
     Parameter('window', 30, 'frames m in the sliding window', 2, 300),
     Parameter('stride', 10, 'buffered frames between window solves (<= window)', 1, 300),
-    Parameter('scale', 0.5, 'processing scale of frames; masks come back at input size',
-              0.05, 1.0),
+    Parameter('scale', 0.5, 'processing scale of frames for the per-frame path (projection, '
+              'decision) and the window; masks come back at input size. The window solve runs '
+              'at this scale up to solve_pixels', 0.05, 1.0),
     Parameter('color', 'rgb', 'gray: one luma channel; rgb: each channel solved, fused by '
               'the largest magnitude', choices=('gray', 'rgb')),
     Parameter('min_frames', 5, 'frames before the first solve (<= window); until then masks '
@@ -103,6 +104,10 @@ PARAMETERS = (
               '(<= stride): the solve runs beside that many frames of per-frame work, and the '
               'masks do not depend on its speed (sync mode and offline; async installs late '
               'solves at the first frame after they end)', 0, 300),
+    Parameter('solve_pixels', 76800, 'largest frame (pixels) the window solve runs at: a '
+              'larger processing size is solved scaled down to this, same aspect, and its '
+              "full-size background carried from the solve's temporal factors (76800 = 320 x "
+              '240, a 640 x 480 camera at scale 0.5)', 64, 100000000),
     Parameter('stream_max_iter', 5, 'ADMM sweeps per window solve while streaming (node, '
               'stream mode): each solve starts from the last, so sweeps add up over '
               'overlapping windows', 1, 10000),
@@ -267,7 +272,7 @@ def detector_settings(values):
             'texture_cue': values['texture_cue'], 'texture_bits': values['texture_bits'],
             'moving_texture_k': values['moving_texture_k'],
             'moving_texture_bits': values['moving_texture_bits'],
-            'solve_lag': values['solve_lag']}
+            'solve_lag': values['solve_lag'], 'solve_pixels': values['solve_pixels']}
 
 
 def validate(values):

@@ -7,6 +7,7 @@ import cv2
 from dgmod_ros import cli
 from dgmod_ros.core.synthetic import synthetic_scene
 import numpy as np
+import pytest
 from rclpy.serialization import deserialize_message
 from ros_harness import DetectorHarness, mask_array
 from rosbags.rosbag2 import Reader
@@ -14,13 +15,16 @@ from sensor_msgs.msg import Image
 import yaml
 
 PARAMETERS = {'window': 20, 'stride': 5, 'scale': 0.5, 'solve_mode': 'sync'}
+# Full resolution with the solve capped at half size: the carried background.
+CAPPED = dict(PARAMETERS, scale=1.0, solve_pixels=48 * 64)
 
 
-def test_bag_through_node_matches_offline_stream_masks(tmp_path):
+@pytest.mark.parametrize('parameters', [PARAMETERS, CAPPED], ids=['defaults', 'capped'])
+def test_bag_through_node_matches_offline_stream_masks(tmp_path, parameters):
     scene = synthetic_scene(n_frames=40, shape=(96, 128), seed=8)
     bag = write_image_bag(tmp_path / 'bag', scene.frames)
 
-    harness = DetectorHarness(**PARAMETERS)
+    harness = DetectorHarness(**parameters)
     try:
         node_masks = []
         with Reader(bag) as reader:
@@ -32,7 +36,7 @@ def test_bag_through_node_matches_offline_stream_masks(tmp_path):
         harness.close()
 
     params = tmp_path / 'detector.yaml'
-    params.write_text(yaml.safe_dump({'/detector': {'ros__parameters': PARAMETERS}}))
+    params.write_text(yaml.safe_dump({'/detector': {'ros__parameters': parameters}}))
     out = tmp_path / 'offline'
     assert cli.main(['separate', str(bag), '--out', str(out), '--config', str(params),
                      '--quiet']) == 0

@@ -103,6 +103,7 @@ class WindowSnapshot:
     first_column: int = None    # admission count of the oldest column (warm-start shift)
     decision: str = 'global'    # likewise the decision rule ('adaptive' needs pixel noise)
     noise_source: str = 'solve'  # likewise the residual the pixel noise comes from
+    solve_shape: tuple = None   # (rows, cols, C) the window is solved at; None: ``shape``
 
 
 @dataclass
@@ -137,6 +138,9 @@ class BackgroundModel:
         Each pixel's chromaticity noise level (the lighting test, colour only).
     first_column : int or None
         Admission count of the window's oldest column.
+    solve_shape : tuple or None
+        (rows, cols, C) the window was solved at (the warm start's size);
+        None: ``shape``.
 
     """
 
@@ -155,3 +159,4 @@ class BackgroundModel:
     noise: np.ndarray = None
     first_column: int = None
     chroma_noise: np.ndarray = None
+    solve_shape: tuple = None

@@ -73,6 +73,9 @@ def check_window_parameters(detector):
     lag = detector.solve_lag
     if int(lag) != lag or not 0 <= lag <= stride:
         raise ValueError(f'solve_lag must be an integer in [0, stride={stride}], got {lag!r}')
+    pixels = detector.solve_pixels
+    if int(pixels) != pixels or pixels < 1:
+        raise ValueError(f'solve_pixels must be a positive integer, got {pixels!r}')
     (detector.mask_rule or MaskRule()).validate()
 
 

@@ -22,6 +22,7 @@ from .held_foreground import still_blob_pixels
 from .photometric import LightingTest
 from .results import FrameResult, WindowSnapshot
 from .settings import assign_validated, check_window_parameters
+from .solve_resolution import solve_shape
 from .window_solve import solve_window
 from ..dgmod import DualGraphMOD
 from ..masks import MaskRule
@@ -66,7 +67,9 @@ class SlidingWindowDetector(StreamingDetector):
     stride : int, default=10
         Frames between solves.
     scale : float, default=0.5
-        Processing scale in (0, 1]; masks come back at the input size.
+        Processing scale in (0, 1] of the per-frame path (projection,
+        decision, the buffered window); masks come back at the input size.
+        The window solve runs at this scale too, up to ``solve_pixels``.
     color : {'gray', 'rgb'}, default='rgb'
         'rgb' solves each channel and fuses the magnitudes by their maximum.
     mask_rule : MaskRule or None
@@ -159,6 +162,13 @@ class SlidingWindowDetector(StreamingDetector):
         beside ``solve_lag`` frames of per-frame work with the same masks
         whatever its speed (the install rule of
         :class:`~dgmod_ros.core.streaming.contract.StreamingDetector`).
+    solve_pixels : int, default=76800
+        Largest frame (pixels) the window solve runs at. A larger processing
+        size is solved scaled down to at most this many pixels, same aspect,
+        and the full-size background carried from the solve's temporal
+        factors (:mod:`~dgmod_ros.core.streaming.solve_resolution`); the
+        default is 320 x 240, the processing size of a 640 x 480 camera at
+        the default ``scale``.
 
     Attributes
     ----------
@@ -180,7 +190,7 @@ class SlidingWindowDetector(StreamingDetector):
                  absorb_frames=300, decision='adaptive', noise_source='solve', pixel_k=6.0,
                  median_size=5, ghost_test=True, still_frames=50, mrf_beta=2.0, chroma_cue=True,
                  texture_cue=True, texture_bits=8, moving_texture_k=3.0, moving_texture_bits=16,
-                 solve_lag=0):
+                 solve_lag=0, solve_pixels=76800):
         self.model = model
         self.window = window
         self.stride = stride
@@ -207,6 +217,7 @@ class SlidingWindowDetector(StreamingDetector):
         self.moving_texture_k = moving_texture_k
         self.moving_texture_bits = moving_texture_bits
         self.solve_lag = solve_lag
+        self.solve_pixels = solve_pixels
         self._validated = False
 
     # ------------------------------------------------------------- set-up
@@ -467,7 +478,8 @@ class SlidingWindowDetector(StreamingDetector):
                               basis_rank=int(self.basis_rank), ticket=self._ticket(),
                               observed=self.buffer_.observed(),
                               first_column=self.buffer_.first_column, decision=self.decision,
-                              noise_source=self.noise_source)
+                              noise_source=self.noise_source,
+                              solve_shape=solve_shape(self.shape_, int(self.solve_pixels)))
 
     def solve(self, snapshot):
         """

@@ -10,7 +10,13 @@ from .fast_path import background_basis, projection_residual
 from .foreground import pixel_noise
 from .photometric import chroma_noise
 from .results import BackgroundModel, SolverFailure
+from .solve_resolution import carry_backgrounds, downsample_window
 from ..separation import separate_channels
+
+
+def _solved_shape(solve):
+    """Return the (rows, cols, C) a snapshot or model is solved at (None: its own shape)."""
+    return tuple(solve.solve_shape or solve.shape)
 
 
 def warm_starts(snapshot):
@@ -18,11 +24,13 @@ def warm_starts(snapshot):
     Return each channel's warm start for the snapshot's solve (None: cold).
 
     The previous solve's states, shifted by the frames the window moved on,
-    when the previous window has the same shape and length and still overlaps.
+    when the previous window has the same shape, solve shape and length and
+    still overlaps.
     """
     channels = snapshot.shape[2]
     previous = snapshot.previous
-    if (previous is None or previous.shape != snapshot.shape or not previous.states
+    if (previous is None or previous.shape != snapshot.shape
+            or _solved_shape(previous) != _solved_shape(snapshot) or not previous.states
             or any(s is None for s in previous.states)):
         return [None] * channels
     if snapshot.first_column is not None and previous.first_column is not None:
@@ -61,6 +69,11 @@ def solve_window(snapshot):
     """
     Separate a snapshot with its own estimator; read nothing else.
 
+    A snapshot whose ``solve_shape`` is smaller than its frames is solved at
+    that size and its full-size background carried from the solve
+    (:mod:`~dgmod_ros.core.streaming.solve_resolution`); the rest (basis,
+    noise levels) is computed at the frames' size either way.
+
     Raises
     ------
     SolverFailure
@@ -68,24 +81,32 @@ def solve_window(snapshot):
 
     """
     rows, cols, channels = snapshot.shape
+    small_shape = _solved_shape(snapshot)
+    carried = small_shape != tuple(snapshot.shape)
     started = time.perf_counter()
+    data = (downsample_window(snapshot.data, snapshot.shape, small_shape) if carried
+            else snapshot.data)
     try:
-        separated = separate_channels(snapshot.model, snapshot.data, (rows, cols),
+        separated = separate_channels(snapshot.model, data, small_shape[:2],
                                       warm_starts(snapshot))
     except (ValueError, FloatingPointError, np.linalg.LinAlgError) as error:
         raise SolverFailure(f'window solve failed: {error}') from error
-    backgrounds = separated.backgrounds
+    backgrounds, residuals = separated.backgrounds, separated.residuals
     if separated.diverged or not all(np.all(np.isfinite(b)) for b in backgrounds):
         raise SolverFailure('window solve produced non-finite values')
+    if carried:
+        backgrounds, residuals = carry_backgrounds(
+            snapshot.data, snapshot.shape, backgrounds, residuals, small_shape,
+            snapshot.basis_rank)
     bases = [background_basis(b, int(snapshot.basis_rank)) for b in backgrounds]
     basis = np.zeros((channels, rows * cols, max(b.shape[1] for b in bases)), dtype=np.float32)
     for channel, channel_basis in enumerate(bases):
         basis[channel, :, :channel_basis.shape[1]] = channel_basis
     noise = chroma = None
     if snapshot.decision != 'global':
-        noise = window_noise(snapshot, separated.residuals, basis)
+        noise = window_noise(snapshot, residuals, basis)
         if channels == 3:
-            chroma = chroma_noise(snapshot.data, separated.residuals, snapshot.shape,
+            chroma = chroma_noise(snapshot.data, residuals, snapshot.shape,
                                   snapshot.observed, snapshot.decision == 'uniform')
     return BackgroundModel(
         basis=basis,
@@ -95,9 +116,10 @@ def solve_window(snapshot):
             rows, cols, channels),
         # The global rule's threshold costs a median over the whole window; the
         # per-pixel decisions read ``noise`` instead.
-        threshold=(separated.threshold(snapshot.mask_rule, snapshot.data)
+        threshold=(snapshot.mask_rule.estimate_threshold(residuals, snapshot.data)
                    if snapshot.decision == 'global' else None),
         shape=snapshot.shape, first_id=snapshot.first_id, last_id=snapshot.last_id,
         states=separated.states, seconds=time.perf_counter() - started,
         iterations=separated.iterations, info=separated.info, ticket=snapshot.ticket,
-        noise=noise, first_column=snapshot.first_column, chroma_noise=chroma)
+        noise=noise, first_column=snapshot.first_column, chroma_noise=chroma,
+        solve_shape=small_shape)

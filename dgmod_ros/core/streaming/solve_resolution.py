@@ -1,0 +1,136 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""
+The window solve at a capped size, and the full-size background carried from it.
+
+A solve costs about its pixel count times its columns and channels, so a solve
+of 640 x 480 frames costs four times one of 320 x 240 ones, while the
+per-frame path (projection, decision) costs far less at any size. Above
+``solve_pixels`` pixels a frame, the window is solved downscaled
+(:func:`solve_shape`) and the full-size background is carried from the
+solve's temporal factors (:func:`carry_backgrounds`): the solve fixes how the
+background changes over the window (its right singular vectors, the frames'
+mixing of a few background images), and each full-size pixel's own time series
+fixes its share of each, wherever the solve did not call that pixel foreground.
+"""
+
+import cv2
+import numpy as np
+
+from .foreground import pixel_noise
+from ..linalg import thin_svd
+
+# Most channels one cv2.resize call takes: OpenCV 5's CV_CN_MAX, and 4 for
+# area averaging at a ratio that is not an integer.
+_RESIZE_CHANNELS = {cv2.INTER_AREA: 4}
+_MAX_CHANNELS = 128
+# Noise levels of the solve's residual above which an entry is held out of the
+# full-size fit (a short solve's S holds much of the noise too, so S's own
+# support would hold out nearly every entry).
+_HELD_OUT_SIGMAS = 3.0
+
+
+def solve_shape(shape, max_pixels):
+    """
+    Return the (rows, cols, C) a window of frames of ``shape`` is solved at.
+
+    ``shape`` itself when a frame has at most ``max_pixels`` pixels; otherwise
+    ``shape`` scaled by one factor in both directions to at most ``max_pixels``
+    pixels (at least 1 x 1), so the rule follows any camera's aspect.
+    """
+    rows, cols = shape[:2]
+    if rows * cols <= max_pixels:
+        return tuple(shape)
+    factor = np.sqrt(max_pixels / (rows * cols))
+    # The small epsilon keeps an exact factor (0.5 of 640 x 480 for 320 x 240) exact.
+    small = (max(1, int(rows * factor + 1e-6)), max(1, int(cols * factor + 1e-6)))
+    return small + tuple(shape[2:])
+
+
+def resample_columns(columns, shape, new_shape, interpolation):
+    """
+    Return an (n, m) matrix of frame columns resampled from ``shape`` to ``new_shape``.
+
+    Each column is one (rows, cols) image; the matrix is read as images of
+    as many channels as one OpenCV call takes.
+    """
+    rows, cols = shape[:2]
+    new_rows, new_cols = new_shape[:2]
+    width = columns.shape[1]
+    image = columns.reshape(rows, cols, width)
+    out = np.empty((new_rows, new_cols, width), dtype=columns.dtype)
+    group = _RESIZE_CHANNELS.get(interpolation, _MAX_CHANNELS)
+    for start in range(0, width, group):
+        part = np.ascontiguousarray(image[:, :, start:start + group])
+        resized = cv2.resize(part, (new_cols, new_rows), interpolation=interpolation)
+        out[:, :, start:start + group] = resized.reshape(new_rows, new_cols, -1)
+    return out.reshape(new_rows * new_cols, width)
+
+
+def downsample_window(data, shape, small_shape):
+    """Return the window (C, n, m) at ``small_shape`` (area averaging, as frames are scaled)."""
+    return np.stack([resample_columns(channel, shape, small_shape, cv2.INTER_AREA)
+                     for channel in data])
+
+
+def carry_backgrounds(data, shape, backgrounds, small_residuals, small_shape, rank):
+    """
+    Return the full-size backgrounds of a window solved at ``small_shape``, and ``D - L``.
+
+    Each channel's full-size background is ``A V^T``: ``V`` (m x r,
+    orthonormal) the solve's leading ``rank`` temporal factors, and each
+    full-size pixel's row of ``A`` the weighted least-squares fit of its own
+    time series on ``V``, starting from the solve's ``L V`` upsampled (``P``).
+    The entries the solve called foreground are weighted out: those whose
+    residual ``D - L`` (largest over the channels) exceeds three times the
+    pixel's noise level (:func:`~dgmod_ros.core.streaming.foreground.pixel_noise`
+    of that residual), upsampled, any overlap counting. The fit is of the
+    detail ``D - P V^T``, and zero detail counts as a tenth of an observed
+    frame (a ridge of ``0.1/m``: it shrinks a fully observed pixel's detail
+    by 0.3% at m = 30, and keeps the system of a pixel seen in fewer than r
+    frames solvable, that pixel keeping the solve's background). A pixel with
+    every entry in has ``V^T V = I`` for its r x r matrix, so its fit is
+    ``D V - P``; only the others solve theirs (batched).
+
+    Parameters
+    ----------
+    data : ndarray (C, n, m) float32
+        The window at full size.
+    shape, small_shape : tuple (rows, cols, ...)
+        Full and solve frame sizes.
+    backgrounds : list of ndarray (n_small, m)
+        The solve's ``L`` of each channel.
+    small_residuals : ndarray (C, n_small, m)
+        The solve's ``D - L``.
+    rank : int
+        Temporal factors carried (the fast path's ``basis_rank``).
+
+    Returns
+    -------
+    backgrounds : list of ndarray (n, m) float32
+    residuals : ndarray (C, n, m) float32
+
+    """
+    magnitude = np.abs(small_residuals).max(axis=0)                       # (n_small, m)
+    noise = pixel_noise(small_residuals, small_shape)
+    held_out = (magnitude > _HELD_OUT_SIGMAS * noise[:, None]).astype(np.float32)
+    held_out = resample_columns(held_out, small_shape, shape, cv2.INTER_LINEAR)
+    partial = np.flatnonzero(held_out.max(axis=1) > 0)      # pixels with an entry out
+    weights = (held_out[partial] == 0).astype(np.float32)    # (k, m)
+    ridge = 0.1 / data.shape[2]
+    full = []
+    residuals = np.empty_like(data)
+    for channel, small in enumerate(backgrounds):
+        _, _, temporal = thin_svd(small, int(rank))                       # (m, r)
+        r = temporal.shape[1]
+        start = resample_columns(small @ temporal, small_shape, shape, cv2.INTER_LINEAR)
+        coef = (data[channel] @ temporal - start) / np.float32(1.0 + ridge)
+        if partial.size:
+            detail = (data[channel][partial] - start[partial] @ temporal.T) * weights
+            outer = (temporal[:, :, None] * temporal[:, None, :]).reshape(-1, r * r)
+            gram = (weights @ outer).reshape(-1, r, r) + ridge * np.eye(r, dtype=np.float32)
+            coef[partial] = np.linalg.solve(gram, (detail @ temporal)[:, :, None])[:, :, 0]
+        background = (start + coef) @ temporal.T
+        np.subtract(data[channel], background, out=residuals[channel])
+        full.append(background)
+    return full, residuals

@@ -1,0 +1,126 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""The window solve at a capped size and the full-size background carried from it."""
+
+import cv2
+from dgmod_ros import config
+from dgmod_ros.core.dgmod import DualGraphMOD
+from dgmod_ros.core.masks import MaskRule
+from dgmod_ros.core.streaming.fast_path import background_basis
+from dgmod_ros.core.streaming.results import WindowSnapshot
+from dgmod_ros.core.streaming.solve_resolution import (downsample_window, resample_columns,
+                                                       solve_shape)
+from dgmod_ros.core.streaming.window_solve import solve_window
+from dgmod_ros.core.synthetic import synthetic_scene
+import numpy as np
+import pytest
+
+FULL = (48, 64, 1)
+HALF = (24, 32, 1)
+
+
+def test_solve_shape_caps_pixels_at_the_frames_aspect():
+    assert solve_shape((480, 640, 3), 320 * 240) == (240, 320, 3)
+    assert solve_shape((240, 320, 3), 320 * 240) == (240, 320, 3)      # at the cap: itself
+    assert solve_shape((256, 384, 3), 320 * 240) == (226, 339, 3)
+    rows, cols, _ = solve_shape((1080, 1920, 1), 320 * 240)
+    assert rows * cols <= 320 * 240 and abs(cols / rows - 1920 / 1080) < 0.01
+
+
+def test_resampling_more_columns_than_one_resize_takes():
+    columns = np.random.default_rng(0).random((HALF[0] * HALF[1], 300), dtype=np.float32)
+    up = resample_columns(columns, HALF, FULL, cv2.INTER_LINEAR)
+    # Column 200 lies in the second group of 128: resized like any other.
+    alone = cv2.resize(columns[:, 200].reshape(HALF[:2]), (FULL[1], FULL[0]),
+                       interpolation=cv2.INTER_LINEAR)
+    assert up.shape == (FULL[0] * FULL[1], 300)
+    assert np.allclose(up[:, 200], alone.ravel())
+
+
+def _low_rank_window(m=24, seed=3):
+    """Return a full-size window (1, n, m): pixel-fine texture, a light ramp, a moving block."""
+    rng = np.random.default_rng(seed)
+    rows, cols, _ = FULL
+    texture = rng.uniform(0.2, 0.8, rows * cols).astype(np.float32)     # detail at every pixel
+    shading = np.linspace(0.0, 1.0, rows * cols, dtype=np.float32)
+    gain = np.linspace(-0.1, 0.1, m, dtype=np.float32)
+    truth = texture[:, None] + shading[:, None] * gain[None, :]           # rank 2
+    data = truth.copy()
+    for frame in range(m):                                                 # 8 x 8 block moving
+        image = data[:, frame].reshape(rows, cols)
+        left = (2 * frame) % (cols - 8)
+        image[20:28, left:left + 8] = 0.05
+    data += rng.normal(0, 0.005, data.shape).astype(np.float32)
+    return truth, data[None]
+
+
+def _solve(data, shape, small_shape):
+    snapshot = WindowSnapshot(
+        data=data, shape=shape, first_id=0, last_id=data.shape[2] - 1, previous=None,
+        model=DualGraphMOD(tol=1e-4, max_iter=200), mask_rule=MaskRule(), basis_rank=2,
+        decision='adaptive', solve_shape=small_shape)
+    return solve_window(snapshot)
+
+
+def _outside_span(basis, truth):
+    """Return the share of ``truth``'s norm outside the basis's column space."""
+    return np.linalg.norm(truth - basis @ (basis.T @ truth)) / np.linalg.norm(truth)
+
+
+def test_carried_basis_reproduces_a_full_size_low_rank_background():
+    truth, data = _low_rank_window()
+    model = _solve(data, FULL, HALF)
+    assert model.shape == FULL and model.solve_shape == HALF
+    assert model.basis.shape == (1, FULL[0] * FULL[1], 2)
+    assert model.noise.shape == (FULL[0] * FULL[1],)
+    # The half-size solve's own L, only upsampled, has lost the pixel-fine
+    # texture: its basis leaves a sizeable part of the true background out.
+    half_data = downsample_window(data, FULL, HALF)
+    half = DualGraphMOD(tol=1e-4, max_iter=200).fit(half_data[0], HALF[:2])
+    upsampled = resample_columns(half.background_, HALF, FULL, cv2.INTER_LINEAR)
+    upsampled_miss = _outside_span(background_basis(upsampled, 2), truth)
+    carried_miss = _outside_span(model.basis[0], truth)
+    assert upsampled_miss > 0.1
+    assert carried_miss < 0.01
+    # The newest background column is the true one, block included: the block
+    # is held out of the fit, so it does not leak into the background.
+    newest = model.background[:, :, 0].ravel()
+    assert np.percentile(np.abs(newest - truth[:, -1]), 99) < 0.02
+
+
+def test_an_uncapped_solve_is_the_solve_at_the_frames_size():
+    _, data = _low_rank_window()
+    capped_above = _solve(data, FULL, FULL)
+    plain = _solve(data, FULL, None)
+    assert np.array_equal(capped_above.basis, plain.basis)
+    assert np.array_equal(capped_above.noise, plain.noise)
+
+
+@pytest.fixture(scope='module')
+def frames():
+    return synthetic_scene(n_frames=40, shape=(48, 64), seed=4).frames
+
+
+def test_detector_solves_capped_and_warm_starts_at_the_solve_size(frames):
+    values = dict(config.DEFAULTS, window=8, stride=3, min_frames=3, scale=1.0,
+                  solve_pixels=24 * 32)
+    detector = config.build_detector(config.validate(values))
+    models = []
+    for frame in frames:
+        result = detector.push(frame)
+        assert result.mask.shape == (48, 64)
+        if detector.solve_due():
+            snapshot = detector.snapshot()
+            assert snapshot.solve_shape == (24, 32, 3)
+            models.append(detector.solve(snapshot))
+            assert detector.install(models[-1])
+    assert len(models) > 3
+    assert all(m.shape == (48, 64, 3) and m.solve_shape == (24, 32, 3) for m in models)
+    assert all(m.basis.shape[1] == 48 * 64 for m in models)
+    # Later solves start from the previous one (a few sweeps each).
+    assert models[-1].states[0].background.shape == (24 * 32, 8)
+    # Changing the cap while running: the next solve starts cold, at the new size.
+    detector.configure(solve_pixels=48 * 64)
+    snapshot = detector.snapshot()
+    assert snapshot.solve_shape == (48, 64, 3)
+    assert detector.solve(snapshot).solve_shape == (48, 64, 3)
