@@ -45,6 +45,20 @@ def parse_value(name, text):
     return type(default)(text)
 
 
+def mask_name(dataset, index):
+    """Name frame ``index``'s mask with its ground truth's number (``gt000000`` -> ``bin000000``).
+
+    ``object_recall.py`` pairs masks and truths by number, and the SBI sequences
+    number from 0 while CDnet numbers from 1: a name from the frame's position
+    compared each SBI mask with the next frame's truth.
+    """
+    if index < len(dataset.truths):
+        digits = ''.join(c for c in dataset.truths[index].stem if c.isdigit())
+        if digits:
+            return f'bin{digits}.png'
+    return f'bin{index + 1:06d}.png'
+
+
 def score_dataset(path, values, mode, masks_dir=None):
     """Run one dataset; return a dict of its scores."""
     dataset = load_dataset(path)
@@ -60,7 +74,7 @@ def score_dataset(path, values, mode, masks_dir=None):
             truth = cv2.imread(str(dataset.truths[frame.index]), cv2.IMREAD_GRAYSCALE)
             counts.add(mask, truth, dataset.roi)
         if out is not None:
-            cv2.imwrite(str(out / f'bin{frame.index + 1:06d}.png'), mask)
+            cv2.imwrite(str(out / mask_name(dataset, frame.index)), mask)
     seconds = time.perf_counter() - started
     row = {'dataset': dataset.name, 'precision': counts.precision, 'recall': counts.recall,
            'fmeasure': counts.fmeasure, 'ms_per_frame': 1000 * seconds / len(frames)}
