@@ -65,6 +65,9 @@ PARAMETERS = (
               'then spans window * memory_spacing frames; 1 = consecutive frames', 1, 1000),
     Parameter('conditional_update', True, 'admit frames with their foreground replaced by the '
               'background, so that a person who stops stays foreground'),
+    Parameter('hold_changes', True, 'the conditional update also keeps out the pixels over '
+              'pixel_k / 2 noise levels from both the background and the frame 5 frames '
+              'before (something passing that the mask missed)'),
     Parameter('absorb_frames', 300, 'foreground older than this many frames enters the '
               'window as it is (a left object then joins the background)', 1, 1000000),
     Parameter('motion_threshold', 0.0, 'frames whose mean absolute change to the last '
@@ -253,6 +256,7 @@ def detector_settings(values):
             'global_change_fraction': values['global_change_fraction'],
             'memory_spacing': values['memory_spacing'],
             'conditional_update': values['conditional_update'],
+            'hold_changes': values['hold_changes'],
             'absorb_frames': values['absorb_frames'], 'decision': values['decision'],
             'noise_source': values['noise_source'],
             'pixel_k': values['pixel_k'], 'median_size': values['median_size'],
