@@ -132,7 +132,6 @@ def conditional_columns(columns, background, foreground, foreground_age, absorb_
     return np.where(replaced[None, :], background, columns), ~replaced
 
 
-
 def held_pixels(mask, away, changing, away_age, young_frames):
     """
     Return the pixels (n,) bool the conditional update keeps out of the window.

@@ -99,7 +99,7 @@ class SlidingWindowDetector(StreamingDetector):
         Admit a frame with its foreground (the mask, dilated by 5 x 5 at the
         processing size) replaced by the background, so that a person who
         stops is not learned into the background.
-    hold_changes : bool, default=True
+    hold_changes : bool, default=False
         The conditional update also keeps out the pixels over ``pixel_k / 2``
         noise levels from the background that are as far from the frame 5
         frames before or have been away for fewer than ``still_frames``
@@ -131,7 +131,7 @@ class SlidingWindowDetector(StreamingDetector):
         than of the frame (something in the window's frames has left; see
         :func:`~dgmod_ros.core.streaming.foreground.ghost_blobs`); their
         pixels enter the window as they are, which heals the background.
-    still_frames : int, default=50
+    still_frames : int, default=25
         Drop pixels that have been in a still blob (at most 1 % of its pixels
         changed by more than ``pixel_k / 2`` noise levels against the frame
         5 frames before) for this many consecutive frames; they enter the
@@ -175,9 +175,9 @@ class SlidingWindowDetector(StreamingDetector):
     def __init__(self, model=None, window=30, stride=10, scale=0.5, color='rgb',
                  mask_rule=None, motion_threshold=0.0, min_frames=5, basis_rank=2,
                  global_change_fraction=0.7, memory_spacing=10, conditional_update=True,
-                 hold_changes=True, absorb_frames=300, decision='adaptive',
+                 hold_changes=False, absorb_frames=300, decision='adaptive',
                  noise_source='solve', pixel_k=6.0, median_size=5, ghost_test=True,
-                 still_frames=50, mrf_beta=2.0, chroma_cue=True, texture_cue=True,
+                 still_frames=25, mrf_beta=2.0, chroma_cue=True, texture_cue=True,
                  texture_bits=8, solve_lag=0):
         self.model = model
         self.window = window
