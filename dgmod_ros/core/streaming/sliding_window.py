@@ -106,6 +106,9 @@ class SlidingWindowDetector(StreamingDetector):
         frames (something passing that the mask missed: learnt, it raises the
         pixel's noise level and hides it further; see
         :func:`~dgmod_ros.core.streaming.background_memory.held_pixels`).
+        Off by default: on a background that moves all the time (leaves) it
+        holds out the observations that teach the window the texture's
+        spread, and the leaves come through (``docs/results.md``).
     absorb_frames : int, default=300
         Foreground older than this many frames is admitted as it is (a left
         object joins the background after about ``absorb_frames + window *
