@@ -66,6 +66,10 @@ PARAMETERS = (
               'then spans window * memory_spacing frames; 1 = consecutive frames', 1, 1000),
     Parameter('conditional_update', True, 'admit frames with their foreground replaced by the '
               'background, so that a person who stops stays foreground'),
+    Parameter('hold_changes', False, 'the conditional update also keeps out the pixels over '
+              'pixel_k / 2 noise levels from the background that change as much within 5 '
+              'frames or have been away for fewer than still_frames frames (something '
+              'passing that the mask missed)'),
     Parameter('absorb_frames', 300, 'foreground older than this many frames enters the '
               'window as it is (a left object then joins the background)', 1, 1000000),
     Parameter('motion_threshold', 0.0, 'frames whose mean absolute change to the last '
@@ -123,7 +127,7 @@ PARAMETERS = (
               choices=('solve', 'projection', 'least_squares', 'max')),
     Parameter('ghost_test', True, 'drop still blobs whose outline is an edge of the background '
               'rather than of the frame (ghosts of what has left); they heal the window'),
-    Parameter('still_frames', 50, 'drop pixels that have been in a still blob (nothing in it '
+    Parameter('still_frames', 25, 'drop pixels that have been in a still blob (nothing in it '
               'changed by pixel_k / 2 noise levels over 5 frames) for this many frames: ghosts '
               'that uncover texture; they heal the window; 0 = off', 0, 1000000),
     Parameter('mrf_beta', 2.0, 'coupling of 5 x 5 neighbours in the Potts field that decides '
@@ -264,6 +268,7 @@ def detector_settings(values):
             'global_change_fraction': values['global_change_fraction'],
             'memory_spacing': values['memory_spacing'],
             'conditional_update': values['conditional_update'],
+            'hold_changes': values['hold_changes'],
             'absorb_frames': values['absorb_frames'], 'decision': values['decision'],
             'noise_source': values['noise_source'],
             'pixel_k': values['pixel_k'], 'median_size': values['median_size'],

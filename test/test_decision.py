@@ -3,6 +3,7 @@
 """The streaming decision's pieces: warm-up noise level, still blobs, held ghosts."""
 
 from dgmod_ros.core.streaming import SlidingWindowDetector
+from dgmod_ros.core.streaming.background_memory import held_pixels
 from dgmod_ros.core.streaming.coherence import mean_field_mask
 from dgmod_ros.core.streaming.fast_path import projection_residual, robust_projection
 from dgmod_ros.core.streaming.foreground import (adaptive_mask, consecutive_frames,
@@ -249,3 +250,54 @@ def test_every_noise_source_gives_a_positive_level_per_pixel(source):
 def test_an_unknown_noise_source_is_refused():
     with pytest.raises(ValueError, match='noise_source'):
         SlidingWindowDetector(noise_source='median').validate()
+
+
+def test_held_pixels_adds_what_is_away_and_changing_or_only_lately_away():
+    mask = np.zeros((2, 3), np.uint8)
+    mask[0, 0] = 255
+    away = np.array([False, True, True, True, False, False])
+    changing = np.array([False, False, True, False, True, False])
+    away_age = np.array([0, 80, 80, 10, 0, 0])
+    held = held_pixels(mask, away, changing, away_age, 50)
+    # 0: the mask; 1: away for 80 frames and still (a released ghost's rim):
+    # admitted; 2: away and changing; 3: away for 10 frames; 4: changing but
+    # at its background (something has left): admitted.
+    assert np.flatnonzero(held).tolist() == [0, 2, 3]
+
+
+def test_held_pixels_without_young_frames_holds_only_what_changes():
+    mask = np.zeros((2, 3), np.uint8)
+    away = np.ones(6, bool)
+    changing = np.array([True, False, False, False, False, False])
+    assert np.flatnonzero(held_pixels(mask, away, changing, np.zeros(6, int), 0)).tolist() == [0]
+
+
+def _newest_column_observed(hold_changes):
+    """
+    Run a wall with a faint box drifting across; return the newest window column's observed pixels.
+
+    The box's contrast is 4.5 noise levels (read from the detector's model once
+    there is one): below the decision's ``pixel_k`` 6, over its half.
+    """
+    rng = np.random.default_rng(5)
+    wall = rng.uniform(0.3, 0.9, (40, 60, 3)).astype(np.float32)
+    detector = SlidingWindowDetector(scale=1.0, hold_changes=hold_changes, ghost_test=False,
+                                     still_frames=0)
+    contrast = 0.05
+    for index in range(45):
+        model = detector.background_model_ if hasattr(detector, 'buffer_') else None
+        if model is not None and model.noise is not None:
+            contrast = 4.5 * float(np.median(model.noise))
+        image = wall + rng.normal(0, 0.004, wall.shape).astype(np.float32)
+        image[10:30, index:index + 8] -= contrast
+        result, _ = detector.process(np.clip(image, 0, 1))
+    assert result.frame_id == 44 and detector.buffer_.last_admitted_id == 39
+    assert not result.mask[10:30, 40:52].any()          # the mask misses the box
+    observed = detector.buffer_.observed()
+    return np.ones((40, 60), bool) if observed is None else observed[:, -1].reshape(40, 60)
+
+
+def test_the_window_keeps_out_what_passes_under_the_threshold():
+    # The column admitted at frame 39, when the box covered columns 39-46.
+    assert not _newest_column_observed(True)[12:28, 41:45].any()
+    assert _newest_column_observed(False)[12:28, 41:45].all()

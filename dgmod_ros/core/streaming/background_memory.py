@@ -16,6 +16,15 @@ foreground for ``absorb_frames`` frames in a row is admitted as it is, so an
 object that stays (or a mistake of the masks) joins the background after
 about ``absorb_frames + m * spacing / 2`` frames, when the l1 fit lets the
 majority of the window win.
+
+What the masks miss is learnt, and learning it hides it further: a slow
+walker whose legs fall below the threshold enters the window at every
+admission, the window's residual there grows, and with it the pixel's noise
+level. :func:`held_pixels` therefore keeps out, with each blob of the mask,
+the pixels that are away from the background by a lower multiple of their
+noise level and changing or only lately away (something passing), and admits
+those that have been away for long without changing (the rim of a ghost
+that the held-still rule released).
 """
 
 from collections import deque
@@ -121,3 +130,31 @@ def conditional_columns(columns, background, foreground, foreground_age, absorb_
     if not replaced.any():
         return columns, None
     return np.where(replaced[None, :], background, columns), ~replaced
+
+
+def held_pixels(mask, away, changing, away_age, young_frames):
+    """
+    Return the pixels (n,) bool the conditional update keeps out of the window.
+
+    The frame's mask, and the pixels away from their background that are
+    changing (against a frame a few frames before) or have been away for
+    fewer than ``young_frames`` frames: something passing that the mask
+    missed (a slow walker's limbs, a reflection). A pixel away from its
+    background for longer and not changing (the rim of a ghost that the
+    held-still rule released) is admitted, so the window heals there.
+
+    Parameters
+    ----------
+    mask : ndarray (rows, cols) uint8
+        The frame's foreground at the processing size.
+    away, changing : ndarray (n,) bool
+        Pixels over a multiple of their noise level from the background, and
+        from the earlier frame.
+    away_age : ndarray (n,) int
+        Consecutive frames each pixel has been ``away``.
+    young_frames : int
+        Frames a pixel away from its background is held even if it does not
+        change.
+
+    """
+    return (mask.ravel() > 0) | (away & (changing | (away_age < young_frames)))

@@ -12,7 +12,7 @@ from collections import deque
 import cv2
 import numpy as np
 
-from .background_memory import BackgroundMemory, conditional_columns
+from .background_memory import BackgroundMemory, conditional_columns, held_pixels
 from .buffer import SceneChangeWatch
 from .contract import StreamingDetector
 from .fast_path import robust_projection
@@ -102,6 +102,16 @@ class SlidingWindowDetector(StreamingDetector):
         Admit a frame with its foreground (the mask, dilated by 5 x 5 at the
         processing size) replaced by the background, so that a person who
         stops is not learned into the background.
+    hold_changes : bool, default=False
+        The conditional update also keeps out the pixels over ``pixel_k / 2``
+        noise levels from the background that are as far from the frame 5
+        frames before or have been away for fewer than ``still_frames``
+        frames (something passing that the mask missed: learnt, it raises the
+        pixel's noise level and hides it further; see
+        :func:`~dgmod_ros.core.streaming.background_memory.held_pixels`).
+        Off by default: on a background that moves all the time (leaves) it
+        holds out the observations that teach the window the texture's
+        spread, and the leaves come through (``docs/results.md``).
     absorb_frames : int, default=300
         Foreground older than this many frames is admitted as it is (a left
         object joins the background after about ``absorb_frames + window *
@@ -127,7 +137,7 @@ class SlidingWindowDetector(StreamingDetector):
         than of the frame (something in the window's frames has left; see
         :func:`~dgmod_ros.core.streaming.foreground.ghost_blobs`); their
         pixels enter the window as they are, which heals the background.
-    still_frames : int, default=50
+    still_frames : int, default=25
         Drop pixels that have been in a still blob (at most 1 % of its pixels
         changed by more than ``pixel_k / 2`` noise levels against the frame
         5 frames before) for this many consecutive frames; they enter the
@@ -187,10 +197,11 @@ class SlidingWindowDetector(StreamingDetector):
     def __init__(self, model=None, window=30, stride=10, scale=0.5, color='rgb',
                  mask_rule=None, motion_threshold=0.0, min_frames=5, basis_rank=2,
                  global_change_fraction=0.7, memory_spacing=10, conditional_update=True,
-                 absorb_frames=300, decision='adaptive', noise_source='solve', pixel_k=6.0,
-                 median_size=5, ghost_test=True, still_frames=50, mrf_beta=2.0, chroma_cue=True,
-                 texture_cue=True, texture_bits=8, moving_texture_k=3.0, moving_texture_bits=16,
-                 solve_lag=0, solve_pixels=76800):
+                 hold_changes=False, absorb_frames=300, decision='adaptive',
+                 noise_source='solve', pixel_k=6.0, median_size=5, ghost_test=True,
+                 still_frames=25, mrf_beta=2.0, chroma_cue=True, texture_cue=True,
+                 texture_bits=8, moving_texture_k=3.0, moving_texture_bits=16, solve_lag=0,
+                 solve_pixels=76800):
         self.model = model
         self.window = window
         self.stride = stride
@@ -203,6 +214,7 @@ class SlidingWindowDetector(StreamingDetector):
         self.global_change_fraction = global_change_fraction
         self.memory_spacing = memory_spacing
         self.conditional_update = conditional_update
+        self.hold_changes = hold_changes
         self.absorb_frames = absorb_frames
         self.decision = decision
         self.noise_source = noise_source
@@ -280,6 +292,7 @@ class SlidingWindowDetector(StreamingDetector):
             self.recent_.clear()            # frames of the old size
             self.foreground_age_ = None
             self.still_age_ = None
+            self.away_age_ = None
         return self
 
     def reset(self):
@@ -288,6 +301,7 @@ class SlidingWindowDetector(StreamingDetector):
         self.buffer_ = BackgroundMemory(int(self.window), int(self.memory_spacing))
         self.foreground_age_ = None
         self.still_age_ = None
+        self.away_age_ = None
         self.recent_ = deque(maxlen=_GHOST_LAG)
         self.scene_watch_ = SceneChangeWatch()
         self.background_model_ = None
@@ -368,7 +382,8 @@ class SlidingWindowDetector(StreamingDetector):
                     and len(self.recent_) == self.recent_.maxlen):
                 self._drop_still(foreground, columns, level)
             result.mask = to_input_size(foreground, self.input_shape_)
-        result.buffered = self._admit(columns, background, foreground, result.frame_id)
+        result.buffered = self._admit(columns, background, foreground, result.frame_id,
+                                      result.magnitude, level)
         self.recent_.append((result.frame_id, columns))
         result.model_ready = self.background_model_ is not None
         result.new_background = self.background_pending_
@@ -385,9 +400,12 @@ class SlidingWindowDetector(StreamingDetector):
         self.still_age_ = consecutive_frames(self.still_age_, still)
         foreground[self.still_age_.reshape(foreground.shape) >= self.still_frames] = 0
 
-    def _admit(self, columns, background, foreground, frame_id):
+    def _admit(self, columns, background, foreground, frame_id, distance, level):
         """Put the frame into the window if due (conditionally); return whether it went in."""
         self.foreground_age_ = consecutive_frames(self.foreground_age_, foreground > 0)
+        if self.hold_changes and self.decision != 'global':
+            self.away_ = distance.ravel() > self.pixel_k / 2 * level
+            self.away_age_ = consecutive_frames(self.away_age_, self.away_)
         if (not self.buffer_.wants(frame_id)
                 or self.buffer_.is_motionless(columns, self.motion_threshold)):
             return False
@@ -397,12 +415,26 @@ class SlidingWindowDetector(StreamingDetector):
         # model learnt from a few frames is no ground for holding pixels back.
         if (self.conditional_update and self.background_model_ is not None
                 and len(self.buffer_) >= self.buffer_.capacity):
+            held = foreground
+            if self.hold_changes and self.decision != 'global':
+                held = self._held(columns, foreground, distance, level)
             # Dilated: a silhouette's border is foreground below the threshold.
-            grown = cv2.dilate(foreground, _BORDER_KERNEL).ravel() > 0
+            grown = cv2.dilate(held, _BORDER_KERNEL).ravel() > 0
             columns, observed = conditional_columns(columns, background, grown,
                                                     self.foreground_age_, self.absorb_frames)
         self.buffer_.append(columns, frame_id, observed)
         return True
+
+    def _held(self, columns, foreground, distance, level):
+        """Return the frame's pixels (rows, cols) uint8 that the conditional update keeps out."""
+        if len(self.recent_) < self.recent_.maxlen:
+            changing = np.zeros_like(self.away_)
+        else:
+            change = np.abs(columns - self.recent_[0][1]).max(axis=0)
+            changing = change > self.pixel_k / 2 * level
+        held = held_pixels(foreground, self.away_, changing, self.away_age_,
+                           self.still_frames)
+        return np.where(held, np.uint8(255), np.uint8(0)).reshape(foreground.shape)
 
     def _restart_from_newest(self, count):
         """Restart the window from the newest ``count`` frames, drop the model (scene change)."""
@@ -413,6 +445,7 @@ class SlidingWindowDetector(StreamingDetector):
         self.since_solve_ = len(self.buffer_)
         self.foreground_age_ = None
         self.still_age_ = None
+        self.away_age_ = None
         self.background_model_ = None
         self.background_pending_ = False
         self.scene_changes_ += 1
