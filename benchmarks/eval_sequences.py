@@ -46,7 +46,8 @@ def parse_value(name, text):
 
 
 def mask_name(dataset, index):
-    """Name frame ``index``'s mask with its ground truth's number (``gt000000`` -> ``bin000000``).
+    """
+    Name frame ``index``'s mask with its ground truth's number (``gt000000`` -> ``bin000000``).
 
     ``object_recall.py`` pairs masks and truths by number, and the SBI sequences
     number from 0 while CDnet numbers from 1: a name from the frame's position
