@@ -234,3 +234,5 @@ def compile_all():
     DualGraphMOD(max_iter=1, l_step='exact').fit(data, (3, 4))
     from .streaming.irls_kernel import compile_kernel     # the fast path's projection
     compile_kernel()
+    from .streaming.mean_field_kernel import compile_kernel as compile_field
+    compile_field()                                       # the per-frame decision
