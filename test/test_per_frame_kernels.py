@@ -2,14 +2,18 @@
 # Licensed under the Apache License, Version 2.0
 """The per-frame path's compiled kernels give their numpy references' results bit for bit."""
 
+import cv2
 from dgmod_ros.core.streaming import mean_field_kernel
+from dgmod_ros.core.streaming.blobs import BlobMotion, moving_share_reference
 from dgmod_ros.core.streaming.coherence import mean_field_mask, mean_field_mask_reference
+from dgmod_ros.core.streaming.foreground import _edge_strength, ghost_blobs, ghost_labels
+from dgmod_ros.core.streaming.held_foreground import still_blob_pixels
 import numpy as np
 import pytest
 
 
 def _field_case(rng, rows, cols, scalar_noise, nan=False):
-    """Return distances and noise levels of a frame with blobs, noise and maybe non-finite pixels."""
+    """Return distances and noise levels of a frame with blobs, noise, maybe non-finite pixels."""
     noise = (float(rng.uniform(0.002, 0.05)) if scalar_noise
              else rng.uniform(0.005, 0.05, rows * cols).astype(np.float32))
     z = np.abs(rng.normal(0, 2.5, (rows, cols))).astype(np.float32)
@@ -34,8 +38,8 @@ def test_mean_field_kernel_gives_the_reference_masks(seed):
                                                    radius, 3.0, 50.0)
         assert (spins is None) == nan
         got = mean_field_mask(distance, noise, k, beta, (rows, cols, 3), sweeps, radius)
-        expected = mean_field_mask_reference(distance, noise, k, beta, (rows, cols, 3), sweeps,
-                                              radius)
+        expected = mean_field_mask_reference(distance, noise, k, beta, (rows, cols, 3),
+                                             sweeps, radius)
         assert got.dtype == np.uint8 and got.shape == (rows, cols)
         assert np.array_equal(got, expected)
 
@@ -62,3 +66,75 @@ def test_a_tiny_or_nan_spin_sends_the_field_to_the_reference():
     assert mean_field_kernel._scatter(index, np.array([0.5, 0.0], np.float32), 2, spin)
     assert not mean_field_kernel._scatter(index, np.array([0.5, 1e-9], np.float32), 2, spin)
     assert not mean_field_kernel._scatter(index, np.array([np.nan, 1.0], np.float32), 2, spin)
+
+
+def _blob_case(seed, rows=60, cols=80):
+    """Return a mask of blobs, a frame, an earlier frame (some blobs still) and noise levels."""
+    rng = np.random.default_rng(seed)
+    n = rows * cols
+    earlier = rng.uniform(0.2, 0.8, (3, n)).astype(np.float32)
+    noise = rng.uniform(0.004, 0.02, n).astype(np.float32)
+    frame = earlier + rng.normal(0, 0.004, (3, n)).astype(np.float32)
+    background = rng.uniform(0.2, 0.8, (3, n)).astype(np.float32)
+    mask = np.zeros((rows, cols), np.uint8)
+    image = frame.reshape(3, rows, cols)
+    for blob in range(6):
+        r, c = rng.integers(0, rows - 8), rng.integers(0, cols - 8)
+        h, w = rng.integers(2, 9), rng.integers(2, 9)
+        mask[r:r + h, c:c + w] = 255
+        if blob % 2:                                    # a moving blob
+            image[:, r:r + h, c:c + w] += rng.uniform(0, 0.3, (3, h, w)).astype(np.float32)
+        elif blob % 3 == 0:                             # a still blob with an edge in the frame
+            image[:, r:r + h, c:c + w] = 0.9
+    frame[0, rng.integers(0, n, 3)] = np.nan
+    return mask, frame, background, earlier, noise
+
+
+def _ghost_blobs_reference(mask, frame, background, earlier, noise, k):
+    """Return the ghost test as numpy on the whole frame (before the shared labelling)."""
+    rows, cols = mask.shape
+    count, labels = cv2.connectedComponents(mask, connectivity=8)
+    moving_share = moving_share_reference(labels, count, frame, earlier, noise, k)
+    border = cv2.morphologyEx(mask, cv2.MORPH_GRADIENT, np.ones((3, 3), np.uint8)) > 0
+    owner = cv2.dilate(labels.astype(np.float32), np.ones((3, 3), np.uint8))
+    owner = owner.astype(np.int32)[border]
+    frame_edges = _edge_strength(frame.mean(axis=0).reshape(rows, cols))[border]
+    background_edges = _edge_strength(background.mean(axis=0).reshape(rows, cols))[border]
+    in_frame = np.bincount(owner, frame_edges, minlength=count)
+    in_background = np.bincount(owner, background_edges, minlength=count)
+    ghost = (moving_share < 0.1) & (in_background > in_frame)
+    ghost[0] = False
+    return ghost[labels]
+
+
+@pytest.mark.parametrize('seed', range(8))
+def test_blob_motion_counts_give_the_reference_shares(seed):
+    mask, frame, _, earlier, noise = _blob_case(seed)
+    blobs = BlobMotion(mask, frame, earlier, noise)
+    for k in (6.0, 3.0, 0.5):
+        expected = moving_share_reference(blobs.labels, blobs.count, frame, earlier, noise, k)
+        assert np.array_equal(blobs.moving_share(k)[1:], expected[1:])
+
+
+@pytest.mark.parametrize('seed', range(8))
+def test_ghost_test_in_the_blobs_box_gives_the_whole_frame_reference(seed):
+    mask, frame, background, earlier, noise = _blob_case(seed)
+    # The background's edges against the frame's: some still blobs are ghosts, some not.
+    for back in (background, frame[::-1].copy(), earlier):
+        expected = _ghost_blobs_reference(mask, frame, back, earlier, noise, 6.0)
+        assert np.array_equal(ghost_blobs(mask, frame, back, earlier, noise, 6.0), expected)
+
+
+@pytest.mark.parametrize('seed', range(8))
+def test_still_test_on_shared_labels_equals_labelling_the_mask_left_by_the_ghost_test(seed):
+    mask, frame, background, earlier, noise = _blob_case(seed)
+    blobs = BlobMotion(mask, frame, earlier, noise)
+    shared = mask.copy()
+    blobs.drop(ghost_labels(blobs, shared, frame, background, 6.0), shared)
+    separate = mask.copy()
+    separate[ghost_blobs(separate, frame, background, earlier, noise, 6.0)] = 0
+    assert np.array_equal(shared, separate)
+    for share in (0.0, 0.01, 0.3):
+        assert np.array_equal(
+            still_blob_pixels(shared, frame, earlier, noise, 3.0, share, blobs),
+            still_blob_pixels(separate, frame, earlier, noise, 3.0, share))

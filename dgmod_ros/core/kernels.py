@@ -236,3 +236,5 @@ def compile_all():
     compile_kernel()
     from .streaming.mean_field_kernel import compile_kernel as compile_field
     compile_field()                                       # the per-frame decision
+    from .streaming.blobs import compile_kernel as compile_blobs
+    compile_blobs()                                       # the ghost and still tests

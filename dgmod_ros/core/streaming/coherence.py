@@ -82,7 +82,7 @@ def mean_field_mask(distance, noise, k, beta, shape, sweeps=SWEEPS, radius=RADIU
 
 
 def mean_field_mask_reference(distance, noise, k, beta, shape, sweeps=SWEEPS, radius=RADIUS):
-    """Return :func:`mean_field_mask` computed in numpy and OpenCV (what the tests compare with)."""
+    """Return :func:`mean_field_mask` computed in numpy and OpenCV (the tests' reference)."""
     rows, cols = shape[:2]
     z = np.minimum(np.reshape(distance, -1) / noise, _Z_CAP * k).reshape(rows, cols)
     unary = ((z * z - k * k) / 2).astype(np.float32)

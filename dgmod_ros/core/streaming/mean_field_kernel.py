@@ -169,7 +169,7 @@ def _sweep(spin, unary, radius, beta, logit_cap, unary_quiet, spin_quiet, new_sp
 @njit(cache=True, nogil=True)
 def _scatter(pending_index, pending_value, count, spin):
     """
-    Write the tanh values into the spins; return False where the reference's sums cannot be matched.
+    Write the tanh values into the spins; return False where the reference's sums may differ.
 
     That is a nonzero spin too small for exact float64 box sums, or a NaN
     spin (a non-finite frame): OpenCV's running sums carry a NaN along the
