@@ -6,7 +6,8 @@ import cv2
 from dgmod_ros.core.streaming import mean_field_kernel
 from dgmod_ros.core.streaming.blobs import BlobMotion, moving_share_reference
 from dgmod_ros.core.streaming.coherence import mean_field_mask, mean_field_mask_reference
-from dgmod_ros.core.streaming.foreground import _edge_strength, ghost_blobs, ghost_labels
+from dgmod_ros.core.streaming.foreground import (_edge_strength, ghost_blobs, ghost_labels,
+                                                 to_input_size)
 from dgmod_ros.core.streaming.held_foreground import still_blob_pixels
 import numpy as np
 import pytest
@@ -138,3 +139,12 @@ def test_still_test_on_shared_labels_equals_labelling_the_mask_left_by_the_ghost
         assert np.array_equal(
             still_blob_pixels(shared, frame, earlier, noise, 3.0, share, blobs),
             still_blob_pixels(separate, frame, earlier, noise, 3.0, share))
+
+
+@pytest.mark.parametrize('rows, cols', [(1, 1), (1, 7), (5, 3), (120, 160), (241, 319)])
+def test_doubling_a_mask_is_the_thresholded_bilinear_interpolation(rows, cols):
+    mask = np.where(np.random.default_rng(rows * cols).random((rows, cols)) < 0.4,
+                    np.uint8(255), np.uint8(0))
+    smooth = cv2.resize(mask, (2 * cols, 2 * rows), interpolation=cv2.INTER_LINEAR)
+    expected = np.where(smooth > 127, np.uint8(255), np.uint8(0))
+    assert np.array_equal(to_input_size(mask, (2 * rows, 2 * cols)), expected)
