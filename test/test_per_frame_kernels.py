@@ -9,6 +9,8 @@ from dgmod_ros.core.streaming.coherence import mean_field_mask, mean_field_mask_
 from dgmod_ros.core.streaming.foreground import (_edge_strength, ghost_blobs, ghost_labels,
                                                  to_input_size)
 from dgmod_ros.core.streaming.held_foreground import still_blob_pixels
+from dgmod_ros.core.streaming.lighting_kernel import explained_pixels
+from dgmod_ros.core.streaming.photometric import LightingTest
 import numpy as np
 import pytest
 
@@ -148,3 +150,27 @@ def test_doubling_a_mask_is_the_thresholded_bilinear_interpolation(rows, cols):
     smooth = cv2.resize(mask, (2 * cols, 2 * rows), interpolation=cv2.INTER_LINEAR)
     expected = np.where(smooth > 127, np.uint8(255), np.uint8(0))
     assert np.array_equal(to_input_size(mask, (2 * rows, 2 * cols)), expected)
+
+
+@pytest.mark.parametrize('seed', range(10))
+def test_lighting_kernel_gives_the_reference_answers(seed):
+    rng = np.random.default_rng(seed)
+    rows, cols = int(rng.integers(1, 40)), int(rng.integers(1, 50))
+    n = rows * cols
+    background = rng.uniform(0, 1, (3, n)).astype(np.float32)
+    background[:, :3] = 0                               # black: no chromaticity
+    # Shadows, reflections (scaled background), other colours, and brightness ratios
+    # at the cue's bound.
+    gain = rng.choice([0.6, 0.635, 0.8, 1.0, 1.2, 1.365, 2.0], n).astype(np.float32)
+    frame = gain * background + rng.normal(0, 0.02, (3, n)).astype(np.float32)
+    frame[:, rng.random(n) < 0.3] = rng.uniform(0, 1, (3, 1)).astype(np.float32)
+    frame[1, 5 % n] = np.nan
+    noise = (rng.uniform(0.002, 0.03, n).astype(np.float32) if seed % 2
+             else float(rng.uniform(0.002, 0.03)))
+    chroma_level = rng.uniform(0.001, 0.02, n).astype(np.float32) if seed % 3 else None
+    candidates = rng.random(n) < 0.7
+    for cues in ((True, True), (True, False), (False, True)):
+        test = LightingTest(*cues, texture_bits=int(rng.integers(0, 12)))
+        args = (frame, background, noise, 6.0, (rows, cols, 3), candidates, chroma_level)
+        assert np.array_equal(test.explains(*args), test.explains_reference(*args))
+        assert explained_pixels(test, *args) is not None

@@ -238,3 +238,5 @@ def compile_all():
     compile_field()                                       # the per-frame decision
     from .streaming.blobs import compile_kernel as compile_blobs
     compile_blobs()                                       # the ghost and still tests
+    from .streaming.lighting_kernel import compile_kernel as compile_lighting
+    compile_lighting()                                    # the lighting test
