@@ -3,6 +3,7 @@
 """The per-frame path's compiled kernels give their numpy references' results bit for bit."""
 
 import cv2
+from dgmod_ros.core.preprocess import frame_columns
 from dgmod_ros.core.streaming import mean_field_kernel
 from dgmod_ros.core.streaming.blobs import BlobMotion, moving_share_reference
 from dgmod_ros.core.streaming.coherence import mean_field_mask, mean_field_mask_reference
@@ -174,3 +175,16 @@ def test_lighting_kernel_gives_the_reference_answers(seed):
         args = (frame, background, noise, 6.0, (rows, cols, 3), candidates, chroma_level)
         assert np.array_equal(test.explains(*args), test.explains_reference(*args))
         assert explained_pixels(test, *args) is not None
+
+
+@pytest.mark.parametrize('dtype', [np.uint8, np.uint16, np.float32, np.float64])
+@pytest.mark.parametrize('channels', [3, 4])
+def test_bgr_frames_give_the_columns_of_their_channels_reversed(dtype, channels):
+    # OpenCV swaps the channels of the swappable types; the reference is the reversed view.
+    rng = np.random.default_rng(channels)
+    image = (rng.random((31, 45, channels)) * (255 if dtype == np.uint8 else 1.0)).astype(dtype)
+    reference = np.ascontiguousarray(image[:, :, 2::-1])
+    for scale in (0.5, 1.0, 0.4):
+        got, shape = frame_columns(image, scale, 'rgb', 'bgr')
+        expected, expected_shape = frame_columns(reference, scale, 'rgb', 'rgb')
+        assert shape == expected_shape and np.array_equal(got, expected)
