@@ -89,7 +89,10 @@ def explained_pixels(test, columns, background, noise, k, shape, candidates, chr
         return None
     rows, cols, channels = shape
     count = rows * cols
-    level = np.ascontiguousarray(np.broadcast_to(np.asarray(noise, dtype=np.float32), (count,)))
+    level = np.asarray(noise, dtype=np.float32)
+    if level.shape != (count,):
+        level = np.full(count, level, dtype=np.float32)
+    level = np.ascontiguousarray(level)
     chroma = level if chroma_level is None else np.ascontiguousarray(chroma_level.reshape(-1))
     explained = np.empty(count, dtype=bool)
     _explain(np.ascontiguousarray(columns), np.ascontiguousarray(background), rows, cols,
