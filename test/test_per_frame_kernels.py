@@ -4,13 +4,12 @@
 
 import cv2
 from dgmod_ros.core.preprocess import frame_columns
-from dgmod_ros.core.streaming import irls_kernel, mean_field_kernel
+from dgmod_ros.core.streaming import mean_field_kernel
 from dgmod_ros.core.streaming.blobs import BlobMotion, moving_share_reference
 from dgmod_ros.core.streaming.coherence import mean_field_mask, mean_field_mask_reference
 from dgmod_ros.core.streaming.foreground import (_edge_strength, ghost_blobs, ghost_labels,
                                                  to_input_size)
 from dgmod_ros.core.streaming.held_foreground import still_blob_pixels
-from dgmod_ros.core.streaming.irls_kernel import weighted_normal_equations
 from dgmod_ros.core.streaming.lighting_kernel import explained_pixels
 from dgmod_ros.core.streaming.photometric import LightingTest
 import numpy as np
@@ -189,20 +188,3 @@ def test_bgr_frames_give_the_columns_of_their_channels_reversed(dtype, channels)
         got, shape = frame_columns(image, scale, 'rgb', 'bgr')
         expected, expected_shape = frame_columns(reference, scale, 'rgb', 'rgb')
         assert shape == expected_shape and np.array_equal(got, expected)
-
-
-@pytest.mark.parametrize('seed', range(6))
-def test_blocked_rank2_pass_gives_the_serial_pass_sums_bit_for_bit(seed):
-    rng = np.random.default_rng(seed)
-    pixels = int(rng.integers(1, 5000))
-    basis = np.stack([np.linalg.qr(rng.normal(size=(pixels, 2)))[0]
-                      for _ in range(3)]).astype(np.float32)
-    columns = (basis @ rng.normal(size=(3, 2, 1)))[..., 0].astype(np.float32)
-    columns += rng.normal(0, 0.01, columns.shape).astype(np.float32)
-    columns[:, :pixels // 5] += 0.5                                 # a person
-    coef = rng.normal(size=(3, 2))
-    blocked = np.empty((3, 2, 2)), np.empty((3, 2))
-    serial = np.empty((3, 2, 2)), np.empty((3, 2))
-    weighted_normal_equations(basis, columns, coef, 1e-3, *blocked)
-    irls_kernel._rank2_equations_serial(basis, columns, coef, 1e-3, *serial)
-    assert np.array_equal(blocked[0], serial[0]) and np.array_equal(blocked[1], serial[1])

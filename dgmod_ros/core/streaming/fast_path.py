@@ -45,16 +45,15 @@ def robust_projection(basis, columns):
         One frame, one column per channel.
 
     """
-    from .irls_kernel import basis_planes, weighted_normal_equations   # numba: on first use
+    from .irls_kernel import weighted_normal_equations    # numba: loaded on first use
     basis = np.ascontiguousarray(basis, dtype=np.float32)
     columns = np.ascontiguousarray(columns, dtype=np.float32)
     channels, _, rank = basis.shape
     coef = np.matmul(columns[:, None, :], basis)[:, 0, :].astype(np.float64)
     gram = np.empty((channels, rank, rank))
     rhs = np.empty((channels, rank))
-    planes = basis_planes(basis) if rank == 2 else None      # once for the three sweeps
     for _ in range(_IRLS_SWEEPS):
-        weighted_normal_equations(basis, columns, coef, _IRLS_FLOOR, gram, rhs, planes)
+        weighted_normal_equations(basis, columns, coef, _IRLS_FLOOR, gram, rhs)
         for channel in range(channels):
             coef[channel] = np.linalg.lstsq(gram[channel], rhs[channel], rcond=None)[0]
     return np.matmul(basis, coef.astype(np.float32)[:, :, None])[:, :, 0]
