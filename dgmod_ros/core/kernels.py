@@ -234,3 +234,9 @@ def compile_all():
     DualGraphMOD(max_iter=1, l_step='exact').fit(data, (3, 4))
     from .streaming.irls_kernel import compile_kernel     # the fast path's projection
     compile_kernel()
+    from .streaming.mean_field_kernel import compile_kernel as compile_field
+    compile_field()                                       # the per-frame decision
+    from .streaming.blobs import compile_kernel as compile_blobs
+    compile_blobs()                                       # the ghost and still tests
+    from .streaming.lighting_kernel import compile_kernel as compile_lighting
+    compile_lighting()                                    # the lighting test

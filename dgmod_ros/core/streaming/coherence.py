@@ -50,6 +50,10 @@ def mean_field_mask(distance, noise, k, beta, shape, sweeps=SWEEPS, radius=RADIU
     """
     Return the foreground (rows, cols) uint8 0/255 of the Potts field over the k-sigma rule.
 
+    The sweeps of :func:`mean_field_mask_reference`, compiled
+    (:mod:`~dgmod_ros.core.streaming.mean_field_kernel`): the same masks bit
+    for bit, falling back to the reference where the kernel cannot promise it.
+
     Parameters
     ----------
     distance : ndarray (n,) or (rows, cols)
@@ -69,6 +73,17 @@ def mean_field_mask(distance, noise, k, beta, shape, sweeps=SWEEPS, radius=RADIU
         Neighbourhood radius ``r`` (square of side ``2 r + 1``).
 
     """
+    from .mean_field_kernel import mean_field_spins     # numba: loaded on first use
+    rows, cols = shape[:2]
+    spin = mean_field_spins(distance, noise, k, beta, rows, cols, sweeps, radius, _Z_CAP,
+                            _LOGIT_CAP)
+    if spin is None:
+        return mean_field_mask_reference(distance, noise, k, beta, shape, sweeps, radius)
+    return np.where(spin > 0, np.uint8(255), np.uint8(0))
+
+
+def mean_field_mask_reference(distance, noise, k, beta, shape, sweeps=SWEEPS, radius=RADIUS):
+    """Return :func:`mean_field_mask` computed in numpy and OpenCV (the tests' reference)."""
     rows, cols = shape[:2]
     k = np.reshape(np.asarray(k, dtype=np.float32), -1)
     z = np.minimum(np.reshape(distance, -1) / noise, _Z_CAP * k)

@@ -28,6 +28,7 @@ the 0/255 mask, thresholded at half.
 import cv2
 import numpy as np
 
+from .blobs import BlobMotion
 from .coherence import mean_field_mask
 from .texture import descriptor_distance, RELATIVE_THRESHOLD
 from ..masks import robust_sigma
@@ -214,9 +215,20 @@ def adaptive_mask(columns, background, noise, k, shape, median_size, mrf_beta=0.
 
 
 def to_input_size(mask, output_shape):
-    """Bring a 0/255 mask to ``output_shape`` by bilinear interpolation thresholded at half."""
+    """
+    Bring a 0/255 mask to ``output_shape`` by bilinear interpolation thresholded at half.
+
+    An exact doubling (the default scale of 0.5) is a copy of each pixel to
+    its 2 x 2 block: there every output pixel's bilinear weights are 9/16 on
+    its nearest input pixel and 7/16 on the others together (the borders
+    replicate), so the interpolation is over half exactly where that pixel
+    is 255, within the fixed-point rounding of OpenCV's.
+    """
     if mask.shape == tuple(output_shape):
         return mask
+    if tuple(output_shape) == (2 * mask.shape[0], 2 * mask.shape[1]):
+        return cv2.resize(mask, (output_shape[1], output_shape[0]),
+                          interpolation=cv2.INTER_NEAREST)
     smooth = cv2.resize(mask, (output_shape[1], output_shape[0]),
                         interpolation=cv2.INTER_LINEAR)
     return np.where(smooth > 127, np.uint8(255), np.uint8(0))
@@ -239,23 +251,7 @@ def consecutive_frames(previous, flags):
     return np.where(flags, previous + 1, 0).astype(np.int32)
 
 
-def blob_motion(mask, frame, earlier, noise, k):
-    """
-    Return the 8-connected blobs of ``mask`` and the share of each that moved.
-
-    Returns ``(count, labels, moving_share)``: the number of labels (0 is the
-    background), the (rows, cols) labels, and per label the share of its pixels
-    whose frame differs from ``earlier`` by more than ``k`` noise levels.
-    """
-    count, labels = cv2.connectedComponents(mask, connectivity=8)
-    flat = labels.ravel()
-    moved = np.abs(frame - earlier).max(axis=0) > k * noise
-    moving_share = (np.bincount(flat, moved, minlength=count)
-                    / np.maximum(np.bincount(flat, minlength=count), 1))
-    return count, labels, moving_share
-
-
-def ghost_blobs(mask, frame, background, earlier, noise, k):
+def ghost_blobs(mask, frame, background, earlier, noise, k, blobs=None):
     """
     Return the pixels (rows, cols) bool of foreground blobs that are ghosts.
 
@@ -277,20 +273,44 @@ def ghost_blobs(mask, frame, background, earlier, noise, k):
         Each pixel's noise level.
     k : float
         Multiple of the noise level that counts as a change.
+    blobs : BlobMotion or None
+        The blobs of ``mask`` against ``earlier`` when already labelled.
 
     """
-    rows, cols = mask.shape
-    count, labels, moving_share = blob_motion(mask, frame, earlier, noise, k)
-    if count <= 1:
-        return np.zeros(mask.shape, dtype=bool)
-    border = cv2.morphologyEx(mask, cv2.MORPH_GRADIENT, np.ones((3, 3), np.uint8)) > 0
-    # Border pixels just outside a blob take the blob's label from a 3 x 3 dilation.
-    owner = cv2.dilate(labels.astype(np.float32), np.ones((3, 3), np.uint8))
-    owner = owner.astype(np.int32)[border]
-    frame_edges = _edge_strength(frame.mean(axis=0).reshape(rows, cols))[border]
-    background_edges = _edge_strength(background.mean(axis=0).reshape(rows, cols))[border]
-    in_frame = np.bincount(owner, frame_edges, minlength=count)
-    in_background = np.bincount(owner, background_edges, minlength=count)
-    ghost = (moving_share < _GHOST_MOVING_SHARE) & (in_background > in_frame)
+    if blobs is None:
+        blobs = BlobMotion(mask, frame, earlier, noise)
+    return blobs.pixels(ghost_labels(blobs, mask, frame, background, k))
+
+
+def ghost_labels(blobs, mask, frame, background, k):
+    """Return per blob (count,) bool whether it is a ghost (see :func:`ghost_blobs`)."""
+    ghost = blobs.moving_share(k) < _GHOST_MOVING_SHARE
     ghost[0] = False
-    return ghost[labels]
+    if not ghost.any():                 # no still blob: the edges cannot make one a ghost
+        return ghost
+    # The borders lie within a pixel of the blobs and their gradients read one
+    # pixel further: the frame's box around the blobs grown by 2 holds all
+    # that the test reads (the operations are per pixel, the same in the box).
+    rows, cols = mask.shape
+    top, bottom = _span(mask.any(axis=1), rows)
+    left, right = _span(mask.any(axis=0), cols)
+    box = np.s_[top:bottom, left:right]
+    square = np.ones((3, 3), np.uint8)
+    border = cv2.morphologyEx(mask[box], cv2.MORPH_GRADIENT, square) > 0
+    # Border pixels just outside a blob take the blob's label from a 3 x 3 dilation.
+    owner = cv2.dilate(blobs.labels[box].astype(np.float32), square)
+    owner = owner.astype(np.int32)[border]
+    channels = frame.shape[0]
+    frame_edges = _edge_strength(frame.reshape(channels, rows, cols)[(slice(None),) + box]
+                                 .mean(axis=0))[border]
+    background_edges = _edge_strength(
+        background.reshape(channels, rows, cols)[(slice(None),) + box].mean(axis=0))[border]
+    in_frame = np.bincount(owner, frame_edges, minlength=blobs.count)
+    in_background = np.bincount(owner, background_edges, minlength=blobs.count)
+    return ghost & (in_background > in_frame)
+
+
+def _span(occupied, size, margin=2):
+    """Return [first - margin, last + 1 + margin) of the True entries, clipped to [0, size)."""
+    where = np.flatnonzero(occupied)
+    return max(int(where[0]) - margin, 0), min(int(where[-1]) + 1 + margin, size)

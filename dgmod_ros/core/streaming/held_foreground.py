@@ -24,12 +24,10 @@ which heals the background; a real object left behind and never touched
 (a bag) goes the same way, earlier than ``absorb_frames``.
 """
 
-import numpy as np
-
-from .foreground import blob_motion
+from .blobs import BlobMotion
 
 
-def still_blob_pixels(mask, frame, earlier, noise, k, share):
+def still_blob_pixels(mask, frame, earlier, noise, k, share, blobs=None):
     """
     Return the pixels (rows, cols) bool of foreground blobs in which nothing moved.
 
@@ -45,11 +43,14 @@ def still_blob_pixels(mask, frame, earlier, noise, k, share):
         Multiple of the noise level that counts as a change.
     share : float
         Largest share of a blob's pixels that may change for the blob to be still.
+    blobs : BlobMotion or None
+        The blobs of ``mask`` (or of a mask from which :meth:`BlobMotion.drop`
+        removed blobs) against ``earlier``, when already labelled.
 
     """
-    count, labels, moving_share = blob_motion(mask, frame, earlier, noise, k)
-    if count <= 1:
-        return np.zeros(mask.shape, dtype=bool)
-    still = moving_share <= share
+    if blobs is None:
+        blobs = BlobMotion(mask, frame, earlier, noise)
+    still = blobs.moving_share(k) <= share
     still[0] = False
-    return still[labels]
+    still &= ~blobs.dropped
+    return blobs.pixels(still)

@@ -13,10 +13,11 @@ import cv2
 import numpy as np
 
 from .background_memory import BackgroundMemory, conditional_columns, held_pixels
+from .blobs import BlobMotion
 from .buffer import SceneChangeWatch
 from .contract import StreamingDetector
 from .fast_path import robust_projection
-from .foreground import (adaptive_mask, consecutive_frames, ghost_blobs, to_input_size,
+from .foreground import (adaptive_mask, consecutive_frames, ghost_labels, to_input_size,
                          warmup_noise)
 from .held_foreground import still_blob_pixels
 from .photometric import LightingTest
@@ -373,14 +374,15 @@ class SlidingWindowDetector(StreamingDetector):
             # the lights of most of the view switch, the lighting test would
             # hide the change while the window still holds the old light.
             changed = result.magnitude.ravel() > self.pixel_k * level
-            if (self.ghost_test and self.background_model_ is not None
+            if ((self.ghost_test or self.still_frames) and self.background_model_ is not None
                     and earlier is not None):
-                ghosts = ghost_blobs(foreground, columns, background, earlier,
-                                     level, self.pixel_k)
-                foreground[ghosts] = 0
-            if (self.still_frames and self.background_model_ is not None
-                    and len(self.recent_) == self.recent_.maxlen):
-                self._drop_still(foreground, columns, level)
+                # One labelling for both tests: the ghost test drops whole blobs.
+                blobs = BlobMotion(foreground, columns, earlier, level)
+                if self.ghost_test:
+                    blobs.drop(ghost_labels(blobs, foreground, columns, background,
+                                            self.pixel_k), foreground)
+                if self.still_frames:
+                    self._drop_still(foreground, columns, level, blobs)
             result.mask = to_input_size(foreground, self.input_shape_)
         result.buffered = self._admit(columns, background, foreground, result.frame_id,
                                       result.magnitude, level)
@@ -393,10 +395,10 @@ class SlidingWindowDetector(StreamingDetector):
             self._restart_from_newest(SceneChangeWatch.FRAMES)
         return result
 
-    def _drop_still(self, foreground, columns, level):
+    def _drop_still(self, foreground, columns, level, blobs):
         """Clear, in place, the pixels of ``foreground`` held still for ``still_frames``."""
         still = still_blob_pixels(foreground, columns, self.recent_[0][1], level,
-                                  self.pixel_k / 2, _STILL_SHARE)
+                                  self.pixel_k / 2, _STILL_SHARE, blobs)
         self.still_age_ = consecutive_frames(self.still_age_, still)
         foreground[self.still_age_.reshape(foreground.shape) >= self.still_frames] = 0
 

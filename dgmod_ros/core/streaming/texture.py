@@ -38,25 +38,54 @@ PATTERN = ((-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1),
            (-2, -2), (-2, 0), (-2, 2), (0, -2), (0, 2), (2, -2), (2, 0), (2, 2))
 #: LBSP's relative similarity threshold (LOBSTER's published default, 0.365).
 RELATIVE_THRESHOLD = 0.365
-_OFFSETS = np.array(PATTERN, dtype=np.int64)
+#: Largest offset of :data:`PATTERN` along a row or a column.
+REACH = 2
+#: :data:`PATTERN` as an (16, 2) array for the kernels.
+OFFSETS = np.array(PATTERN, dtype=np.int64)
+
+
+@njit(cache=True, nogil=True, inline='always')
+def channel_bits(frame, background, channel, row, col, rows, cols, limit, offsets, window):
+    """
+    Count the differing LBSP bits of one channel at one pixel; the border is replicated.
+
+    ``frame`` and ``background`` are (C, rows * cols); ``window`` holds the
+    flat positions of the pattern's neighbours from the top-left corner of
+    the pixel's 5 x 5 window (:func:`window_offsets`), used inside the border.
+    """
+    reference = background[channel, row * cols + col]
+    count = 0
+    if REACH <= row < rows - REACH and REACH <= col < cols - REACH:
+        # Inside the border (most pixels): views from the window's corner, no clamping.
+        corner = (row - REACH) * cols + col - REACH
+        in_frame = frame[channel, corner:]
+        in_background = background[channel, corner:]
+        for o in range(window.shape[0]):
+            count += ((abs(in_frame[window[o]] - reference) > limit)
+                      != (abs(in_background[window[o]] - reference) > limit))
+        return count
+    for o in range(offsets.shape[0]):
+        neighbour = (min(max(row + offsets[o, 0], 0), rows - 1) * cols
+                     + min(max(col + offsets[o, 1], 0), cols - 1))
+        count += ((abs(frame[channel, neighbour] - reference) > limit)
+                  != (abs(background[channel, neighbour] - reference) > limit))
+    return count
+
+
+def window_offsets(cols):
+    """Return the flat positions (16,) int64 of the pattern's neighbours from a window's corner."""
+    return (OFFSETS[:, 0] + REACH) * cols + OFFSETS[:, 1] + REACH
 
 
 @njit(cache=True, nogil=True)
-def _hamming(frame, background, threshold, pixels, offsets, out):
-    """Count the differing LBSP bits at each pixel; the image border is replicated."""
-    channels, rows, cols = frame.shape
+def _hamming(frame, background, rows, cols, threshold, pixels, offsets, window, out):
+    """Count the differing LBSP bits at each pixel, summed over the channels."""
     for index in range(pixels.shape[0]):
         row, col = pixels[index] // cols, pixels[index] % cols
         count = 0
-        for channel in range(channels):
-            reference = background[channel, row, col]
-            limit = threshold[channel, index]
-            for o in range(offsets.shape[0]):
-                r = min(max(row + offsets[o, 0], 0), rows - 1)
-                c = min(max(col + offsets[o, 1], 0), cols - 1)
-                in_frame = abs(frame[channel, r, c] - reference) > limit
-                in_background = abs(background[channel, r, c] - reference) > limit
-                count += in_frame != in_background
+        for channel in range(frame.shape[0]):
+            count += channel_bits(frame, background, channel, row, col, rows, cols,
+                                  threshold[channel, index], offsets, window)
         out[index] = count
 
 
@@ -80,9 +109,11 @@ def descriptor_distance(frame, background, threshold, pixels):
         Bits that differ, summed over the channels.
 
     """
+    channels, rows, cols = frame.shape
     pixels = np.ascontiguousarray(pixels, dtype=np.int64)
     out = np.empty(pixels.shape[0], dtype=np.uint8)
-    _hamming(np.ascontiguousarray(frame, dtype=np.float32),
-             np.ascontiguousarray(background, dtype=np.float32),
-             np.ascontiguousarray(threshold, dtype=np.float32), pixels, _OFFSETS, out)
+    _hamming(np.ascontiguousarray(frame, dtype=np.float32).reshape(channels, rows * cols),
+             np.ascontiguousarray(background, dtype=np.float32).reshape(channels, rows * cols),
+             rows, cols, np.ascontiguousarray(threshold, dtype=np.float32), pixels, OFFSETS,
+             window_offsets(cols), out)
     return out

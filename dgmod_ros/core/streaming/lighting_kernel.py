@@ -1,0 +1,110 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""
+The lighting test in one compiled pass over the candidate pixels (same answers as numpy).
+
+:meth:`~dgmod_ros.core.streaming.photometric.LightingTest.explains_reference`
+gathers the candidates' colours, forms the brightness ratio and the
+chromaticity distortion in a dozen numpy passes and describes every
+candidate's texture. :func:`explained_pixels` visits each candidate once:
+brightness, chromaticity, then the LBSP distance only for a candidate the
+first cues still call light (the reference ANDs the cues, so the others'
+distance cannot change the answer). The arithmetic is the reference's in
+float32, operation for operation (``einsum``'s sums of products add the
+channels in order, with no fused multiply-add; Python scalars enter numpy's
+arithmetic as float32), so the answers are the same bit for bit; inputs of
+another type go to the reference.
+
+Importing :mod:`dgmod_ros.core.kernels` first (through
+:mod:`~dgmod_ros.core.streaming.texture`) makes its process-wide numba
+settings (cache folder, ``threadsafe`` threading layer) hold here too.
+"""
+
+import math
+
+from numba import njit
+import numpy as np
+
+# texture imports kernels first: numba's cache folder and threading layer are
+# set before the decorators below run.
+from .texture import channel_bits, OFFSETS, RELATIVE_THRESHOLD, window_offsets
+
+# The reference's smallest squared background norm, as numpy's float32 comparison takes it.
+_DARK = np.float32(1e-6)
+
+
+@njit(cache=True, nogil=True, inline='always')
+def _nan_maximum(a, b):
+    """Return ``np.maximum(a, b)``: NaN if either is NaN."""
+    if a != a or b != b:
+        return a + b
+    return a if a >= b else b
+
+
+@njit(cache=True, nogil=True)
+def _explain(frame, background, rows, cols, noise, chroma_level, candidates, k, relative,
+             use_chroma, use_texture, texture_bits, offsets, window, explained):
+    channels = frame.shape[0]
+    one = np.float32(1.0)
+    for i in range(candidates.shape[0]):
+        if not candidates[i]:
+            explained[i] = False
+            continue
+        row, col = i // cols, i % cols
+        energy = np.float32(0.0)
+        dot = np.float32(0.0)
+        for c in range(channels):
+            energy += background[c, i] * background[c, i]
+            dot += frame[c, i] * background[c, i]
+        energy = _nan_maximum(energy, _DARK)
+        alpha = dot / energy
+        light = abs(alpha - one) <= relative
+        if light and use_chroma:
+            across = np.float32(0.0)
+            for c in range(channels):
+                difference = frame[c, i] - alpha * background[c, i]
+                across += difference * difference
+            light = math.sqrt(across) <= k * chroma_level[i]
+        if light and use_texture:
+            level = k * noise[i]
+            bits = 0
+            for c in range(channels):
+                limit = _nan_maximum(relative * background[c, i], level)
+                bits += channel_bits(frame, background, c, row, col, rows, cols, limit,
+                                     offsets, window)
+            light = bits <= texture_bits
+        explained[i] = light
+
+
+def explained_pixels(test, columns, background, noise, k, shape, candidates, chroma_level):
+    """
+    Return :meth:`LightingTest.explains`'s answer (n,) bool, or None for the reference's inputs.
+
+    None unless the data are float32, ``k`` is a Python number and the
+    chromaticity levels (if given) are float32: numpy computes in float64 otherwise.
+    """
+    if (columns.dtype != np.float32 or background.dtype != np.float32
+            or type(k) not in (float, int)
+            or (chroma_level is not None and np.asarray(chroma_level).dtype != np.float32)):
+        return None
+    rows, cols, channels = shape
+    count = rows * cols
+    level = np.asarray(noise, dtype=np.float32)
+    if level.shape != (count,):
+        level = np.full(count, level, dtype=np.float32)
+    level = np.ascontiguousarray(level)
+    chroma = level if chroma_level is None else np.ascontiguousarray(chroma_level.reshape(-1))
+    explained = np.empty(count, dtype=bool)
+    _explain(np.ascontiguousarray(columns), np.ascontiguousarray(background), rows, cols,
+             level, chroma, np.ascontiguousarray(candidates.reshape(-1)), np.float32(k),
+             np.float32(RELATIVE_THRESHOLD), bool(test.chroma), bool(test.texture),
+             int(test.texture_bits), OFFSETS, window_offsets(cols), explained)
+    return explained
+
+
+def compile_kernel():
+    """Compile (or load from the cache) the pass on a tiny input."""
+    from .photometric import LightingTest
+    frame = np.linspace(0.1, 0.9, 3 * 30, dtype=np.float32).reshape(3, 30)
+    LightingTest().explains(frame, frame * np.float32(0.9), 0.01, 6.0, (5, 6, 3),
+                            np.ones(30, dtype=bool))
