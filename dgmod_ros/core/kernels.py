@@ -4,8 +4,8 @@
 Fused, multi-threaded kernels of one ADMM sweep of :class:`DualGraphMOD`.
 
 A sweep of the numpy formulation is about 25 single-threaded passes over
-``n x m`` float32 arrays. Here it is one pass, threaded over blocks of pixel
-rows (:func:`primal_pass`): the gradient L-step (spatial and temporal
+``n x m`` float32 arrays. Here it is one pass, threaded over blocks of pixels
+(:func:`primal_pass`): the gradient L-step (spatial and temporal
 Laplacians applied as diagonal bands), the S- and V-shrinkages, the dual
 update of ``Y2``, the next SVT input ``Lh`` and the sums of squares behind the
 stopping rule. ``Y1`` is never stored (``Y1 = U - Lh`` after every U-step),
@@ -14,8 +14,15 @@ arrays as the sweep needs (docs/solver.md, "Fused sweep").
 :func:`squared_gap` gives the primal residual ``||U - L||`` where the next
 pass cannot wait for it.
 
+The pass runs on the **frames-major** transposes ``(m, n)`` of the matrices
+(:func:`frames_major`): a frame's pixels are one contiguous row, so each
+step is a long unit-stride loop over a block's pixels that the compiler
+vectorises. In the ``n x m`` layout a row holds a pixel's ``m`` = 30 frames,
+too few for the vector loop to start, and the pass ran scalar
+(docs/solver.md, "Frames-major sweep").
+
 Between passes the weighted SVT stays with BLAS: the Gram matrix ``Lh^T Lh``
-and the rank-k product ``U = (Lh left) right_t`` are dense products that a
+and the product ``U = Lh (left right_t)`` are dense products that a
 hand-written loop does several times slower than sgemm.
 
 Import side effects, all process-wide and made before the first compiled call:
