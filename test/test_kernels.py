@@ -3,6 +3,7 @@
 """The fused numba sweep against the literal numpy sweep, and kernels from two threads."""
 
 import ctypes
+from dataclasses import replace
 import os
 from pathlib import Path
 import subprocess
@@ -11,6 +12,7 @@ import threading
 
 from dgmod_ros.core import kernels
 from dgmod_ros.core.dgmod import DualGraphMOD
+from dgmod_ros.core.linalg import c_order
 from dgmod_ros.core.runtime import limit_blas_threads
 from dgmod_ros.core.synthetic import synthetic_scene
 import numba
@@ -190,3 +192,28 @@ def test_threading_layer_survives_numba_imported_first(tmp_path):
     done = subprocess.run([sys.executable, '-c', script], capture_output=True, text=True,
                           env=env, cwd=str(Path(__file__).resolve().parents[1]), check=True)
     assert done.stdout.strip() == 'threadsafe'
+
+
+def test_frames_major_and_c_order_are_transposes_without_needless_copies():
+    matrix = scene_window()
+    frames = kernels.frames_major(matrix)
+    assert frames.flags.c_contiguous and np.array_equal(frames, matrix.T)
+    # The solver's F-ordered state: its transpose is the frames-major array itself.
+    assert np.shares_memory(kernels.frames_major(frames.T), frames)
+    for source in (matrix, frames.T, matrix[::2]):      # C, F, strided
+        ordered = c_order(source)
+        assert ordered.flags.c_contiguous and np.array_equal(ordered, source)
+    assert c_order(matrix) is matrix
+
+
+def test_fused_state_is_frames_major_and_warm_starts_as_a_c_ordered_copy():
+    data = scene_window()
+    first = DualGraphMOD(tol=1e-3).fit(data[:, :-4], SHAPE)
+    for name in STATE:
+        assert getattr(first.state_, name).flags.f_contiguous, name
+    init = first.state_.shifted(4)
+    copied = replace(init, **{name: np.ascontiguousarray(getattr(init, name)) for name in STATE})
+    again = [DualGraphMOD(tol=1e-12, max_iter=5).fit(data[:, 4:], SHAPE, init=start)
+             for start in (init, copied)]
+    # The memory order is no input of the solver: the same iterates bit for bit.
+    assert_same_iterates(again[0], again[1], atol=0.0)

@@ -6,7 +6,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .graphs import banded_matrix, spatial_laplacian_bands, temporal_laplacian
+from .graphs import banded_matrix, data_gram, spatial_laplacian_bands, temporal_laplacian
 from .linalg import (drop_oldest, gram_eigh, mixing_factors, relative_change, shrink,
                      singular_value_map, top_singular_value)
 from .runtime import limit_blas_threads
@@ -230,8 +230,9 @@ class DualGraphMOD:
 
     # ------------------------------------------------------------------ steps
     def _initial_state(self, data):
-        background = np.median(data, axis=1, keepdims=True).astype(np.float32)
-        background = np.repeat(background, data.shape[1], axis=1)
+        median = np.median(data, axis=1, keepdims=True).astype(np.float32)
+        background = np.empty_like(data)        # in the memory order of data
+        background[...] = median
         zeros = np.zeros_like(data)
         return ADMMState(background=background, foreground=data - background,
                          low_rank=background.copy(), noise=zeros, dual_low_rank=zeros.copy(),
@@ -383,18 +384,19 @@ class DualGraphMOD:
         iterates and the same stopping sweep; after the primal pass BLAS forms
         the Gram matrix of ``Lh = L - Y1`` and the SVT as the rank-k product
         ``U = (Lh left) right_t``. ``Y1`` lives as ``U - Lh`` (kernels module
-        docstring) and is formed once, at the end.
+        docstring) and is formed once, at the end. The pass runs on the
+        frames-major transposes of the iterates (:func:`kernels.frames_major`);
+        the iterates handed back are ``n x m`` views of them (F-ordered), so a
+        warm start from them needs no transpose.
         """
         from . import kernels       # numba compiles or loads its cache on first use
         # Again at every solve: an OpenBLAS loaded since (scipy.linalg's) must
         # not spin beside the kernels either (kernels module docstring).
         limit_blas_threads(1)
 
-        def contiguous(array):      # fit's copies already are; no second copy
-            return np.require(array, np.float32, ['C', 'W'])
-
-        L, S, U, V, Y2 = (contiguous(iterates[k]) for k in ('L', 'S', 'U', 'V', 'Y2'))
-        Lh = U - iterates['Y1']     # so that U - Lh is the given Y1
+        D = kernels.frames_major(data)
+        L, S, U, V, Y2 = (kernels.frames_major(iterates[k]) for k in ('L', 'S', 'U', 'V', 'Y2'))
+        Lh = U - kernels.frames_major(iterates['Y1'])   # so that U - Lh is the given Y1
         weights, sigma = iterates['weights'], iterates['sigma']
         rho1, rho2 = float(self.rho1), float(self.rho2)
         g1, g2, c = float(self.gamma1), float(self.gamma2), rho1 + rho2
@@ -405,7 +407,7 @@ class DualGraphMOD:
         t_offsets, t_bands = kernels.diagonal_bands(ops['phi_t'])
         # Other L-steps than one gradient step run in numpy and hand L_new over.
         l_given = not (self.l_step == 'gradient' and self.inner_iter == 1)
-        L_new, S_new = np.empty_like(data), np.empty_like(data)
+        L_new, S_new = np.empty_like(D), np.empty_like(D)
         rhs = work = Y1 = None
         threshold = self.lambda1_ / rho1
         # A sweep's residual ||U - L|| needs its SVT, so the next pass sums it;
@@ -426,19 +428,19 @@ class DualGraphMOD:
                 if stop:
                     self.info_ = 0
                     break
-            if l_given:
+            if l_given:     # the numpy steps on n x m views of the frames-major arrays
                 if rhs is None:
-                    rhs, work, Y1 = (np.empty_like(data) for _ in range(3))
+                    rhs, work, Y1 = (np.empty_like(D) for _ in range(3))
                 np.subtract(U, Lh, out=Y1)
-                self._l_rhs(data, U, Y1, S, V, Y2, rhs, work)
-                np.copyto(L_new, self._l_step(rhs, L, ops, c))
+                self._l_rhs(data, U.T, Y1.T, S.T, V.T, Y2.T, rhs.T, work.T)
+                np.copyto(L_new.T, self._l_step(rhs.T, L.T, ops, c))
             sums = kernels.primal_pass(
-                data, L, U, Lh, S, V, Y2, s_offsets, s_bands, t_offsets, t_bands,
+                D, L, U, Lh, S, V, Y2, s_offsets, s_bands, t_offsets, t_bands,
                 coefficients, l_given, L_new, S_new)
             if pending is not None:
                 finish(sums[4])     # not below tol: pending's own figures are not
                 pending = None
-            gram = Lh.T @ Lh
+            gram = Lh @ Lh.T
             if not (np.isfinite(gram).all() and np.isfinite(sums[:4]).all()):
                 # L and S are the last finite iterate; V, Y2 and Lh were
                 # overwritten in place: the state restarts U, V and the duals
@@ -458,18 +460,20 @@ class DualGraphMOD:
             weights = np.exp(-(sigma / self.weight_scale_) ** 2).astype(np.float32)
             L, L_new = L_new, L
             S, S_new = S_new, S
-            np.matmul(Lh @ left.astype(np.float32), right_t.astype(np.float32), out=U)
+            # U^T = (left right_t)^T Lh^T, frames-major: one m x m product.
+            np.matmul((left @ right_t).T.astype(np.float32), Lh, out=U)
             pending = (_ratio(sums[0], sums[1]), _ratio(sums[2], sums[3]),
                        float(np.sqrt(sums[5])) / data_norm, rank)
         if pending is not None and finish(kernels.squared_gap(U, L)):
             self.info_ = 0          # the last sweep's residual, after the loop
-        iterates.update(L=L, S=S, U=U, V=V, Y1=np.subtract(U, Lh, out=Lh), Y2=Y2,
+        Y1 = np.subtract(U, Lh, out=Lh)
+        iterates.update(L=L.T, S=S.T, U=U.T, V=V.T, Y1=Y1.T, Y2=Y2.T,
                         weights=weights, sigma=sigma)
 
     # ------------------------------------------------------------------ public
     def build_operators(self, data, frame_shape):
         """
-        Graph Laplacians and the temporal eigenbasis for one window.
+        Graph Laplacians, the temporal eigenbasis and the data's Gram matrix for one window.
 
         ``phi_s_bands`` holds the spatial Laplacian's diagonal bands (what the
         fused sweep applies); the sparse ``phi_s`` of the numpy steps is formed
@@ -477,10 +481,11 @@ class DualGraphMOD:
         """
         offsets, bands, self.h_s_ = spatial_laplacian_bands(
             data, frame_shape, self.patch_size, self.h_s, self.smoothing_sigma)
-        phi_t, self.h_t_ = temporal_laplacian(data, self.temporal_neighbors, self.h_t)
+        gram = data_gram(data)
+        phi_t, self.h_t_ = temporal_laplacian(data, self.temporal_neighbors, self.h_t, gram)
         mu, basis = np.linalg.eigh(phi_t.toarray())
         return _Operators(phi_s_bands=(offsets, bands), phi_t=phi_t.astype(np.float32).toarray(),
-                          basis=basis.astype(np.float32), mu=mu)
+                          basis=basis.astype(np.float32), mu=mu, data_gram=gram)
 
     def objective(self, data, frame_shape):
         """
@@ -532,17 +537,29 @@ class DualGraphMOD:
         ops = self.build_operators(data, frame_shape)
         data_norm = float(np.linalg.norm(data)) or 1.0
         if self.weight_scale is None:
-            self.weight_scale_ = 0.1 * top_singular_value(data) or 1.0
+            self.weight_scale_ = 0.1 * top_singular_value(data, ops['data_gram']) or 1.0
         else:
             self.weight_scale_ = float(self.weight_scale)
 
+        if self.engine == 'fused' and self.svd == 'gram':
+            # The compiled pass runs frames-major; ``data`` becomes an n x m
+            # view of the transpose, so that the state's arithmetic below
+            # runs in one memory order (kernels.frames_major).
+            from . import kernels
+            data = kernels.frames_major(data).T
         state = self._initial_state(data) if init is None else replace(init)
-        L = state.background.copy()
+        # Copies in the state's own memory order: the fused solver's state is
+        # frames-major, and a copy into C order would be a strided transpose.
+        L = state.background.copy(order='K')
         # A warm start's new columns know nothing of the new frames: putting
         # the whole residual into S satisfies D = L + S + V exactly.
-        S = data - L - state.noise if init is not None else state.foreground.copy()
-        U, V = state.low_rank.copy(), state.noise.copy()
-        Y1, Y2 = state.dual_low_rank.copy(), state.dual_noise.copy()
+        if init is not None:
+            S = np.subtract(data, L, out=np.empty_like(L))
+            S -= state.noise
+        else:
+            S = state.foreground.copy(order='K')
+        U, V = state.low_rank.copy(order='K'), state.noise.copy(order='K')
+        Y1, Y2 = state.dual_low_rank.copy(order='K'), state.dual_noise.copy(order='K')
         iterates = {'L': L, 'S': S, 'U': U, 'V': V, 'Y1': Y1, 'Y2': Y2,
                     'weights': state.weights, 'sigma': np.zeros(m)}
         history = {k: [] for k in ('change_L', 'change_S', 'residual_U', 'residual_V', 'rank')}

@@ -40,7 +40,7 @@ def _gaussian_weights(sq_dist, h):
     return np.exp(-sq_dist / h2), np.sqrt(h2)
 
 
-def temporal_laplacian(data, neighbors=4, h=None):
+def temporal_laplacian(data, neighbors=4, h=None, gram=None):
     """
     Laplacian ``Phi_t`` (m x m) of the graph over the frames of a window.
 
@@ -54,6 +54,9 @@ def temporal_laplacian(data, neighbors=4, h=None):
     h : float or None, default=None
         Temporal filtering parameter ``h_t``; None picks the median edge
         distance (see module docstring).
+    gram : ndarray (m, m) or None
+        ``(data.T @ data)`` in float64 where the caller has it already (the
+        solver shares it with the weights' scale); None computes it.
 
     Returns
     -------
@@ -62,7 +65,8 @@ def temporal_laplacian(data, neighbors=4, h=None):
 
     """
     m = data.shape[1]
-    gram = (data.T @ data).astype(np.float64)
+    if gram is None:
+        gram = data_gram(data)
     sq_norm = np.diag(gram)
     reach = max(1, neighbors // 2)
     rows, cols = [], []
@@ -78,6 +82,11 @@ def temporal_laplacian(data, neighbors=4, h=None):
     adjacency = sp.coo_matrix((np.r_[weights, weights], (np.r_[rows, cols], np.r_[cols, rows])),
                               shape=(m, m))
     return normalized_laplacian(adjacency), h_used
+
+
+def data_gram(data):
+    """Return ``data.T @ data`` (m x m) in float64, from the float32 product."""
+    return (data.T @ data).astype(np.float64)
 
 
 def _box_sum(image, patch_size):

@@ -4,8 +4,8 @@
 Fused, multi-threaded kernels of one ADMM sweep of :class:`DualGraphMOD`.
 
 A sweep of the numpy formulation is about 25 single-threaded passes over
-``n x m`` float32 arrays. Here it is one pass, threaded over blocks of pixel
-rows (:func:`primal_pass`): the gradient L-step (spatial and temporal
+``n x m`` float32 arrays. Here it is one pass, threaded over blocks of pixels
+(:func:`primal_pass`): the gradient L-step (spatial and temporal
 Laplacians applied as diagonal bands), the S- and V-shrinkages, the dual
 update of ``Y2``, the next SVT input ``Lh`` and the sums of squares behind the
 stopping rule. ``Y1`` is never stored (``Y1 = U - Lh`` after every U-step),
@@ -14,8 +14,15 @@ arrays as the sweep needs (docs/solver.md, "Fused sweep").
 :func:`squared_gap` gives the primal residual ``||U - L||`` where the next
 pass cannot wait for it.
 
+The pass runs on the **frames-major** transposes ``(m, n)`` of the matrices
+(:func:`frames_major`): a frame's pixels are one contiguous row, so each
+step is a long unit-stride loop over a block's pixels that the compiler
+vectorises. In the ``n x m`` layout a row holds a pixel's ``m`` = 30 frames,
+too few for the vector loop to start, and the pass ran scalar
+(docs/solver.md, "Frames-major sweep").
+
 Between passes the weighted SVT stays with BLAS: the Gram matrix ``Lh^T Lh``
-and the rank-k product ``U = (Lh left) right_t`` are dense products that a
+and the product ``U = Lh (left right_t)`` are dense products that a
 hand-written loop does several times slower than sgemm.
 
 Import side effects, all process-wide and made before the first compiled call:
@@ -55,6 +62,7 @@ from numba import njit, prange  # noqa: E402
 import numpy as np  # noqa: E402
 import scipy.sparse as sp  # noqa: E402
 
+from .linalg import c_order  # noqa: E402
 from .runtime import limit_blas_threads  # noqa: E402
 
 if not numba.config.CACHE_DIR:      # numba was imported before this module
@@ -62,9 +70,10 @@ if not numba.config.CACHE_DIR:      # numba was imported before this module
 numba.config.THREADING_LAYER = 'threadsafe'
 limit_blas_threads(1)
 
-# Rows per block of the threaded loops: enough to amortise the per-block
-# scratch rows, few enough to balance two to eight threads.
-_BLOCK_ROWS = 256
+# Pixels per block of the threaded loops: long enough rows for the vector
+# loops, blocks few enough per thread to amortise the per-block scratch
+# rows, many enough (75 at 320 x 240) to balance two to eight threads.
+_BLOCK_PIXELS = 1024
 
 
 def diagonal_bands(matrix):
@@ -100,124 +109,160 @@ def _shrink(x, t):
 _FAST = {'reassoc', 'contract', 'nsz'}
 
 
+@njit(cache=True, inline='always', fastmath=_FAST)
+def _add_product(weights, values, out):
+    """``out += weights * values`` over three equally long rows."""
+    for i in range(out.size):
+        out[i] += weights[i] * values[i]
+
+
+@njit(cache=True, inline='always', fastmath=_FAST)
+def _add_scaled(weight, values, out):
+    """``out += weight * values`` over two equally long rows."""
+    for i in range(out.size):
+        out[i] += weight * values[i]
+
+
+@njit(cache=True, inline='always', fastmath=_FAST)
+def _gradient_step(d, bg, u, lh, s, v, y2, spatial, temporal, l_new, coefficients):
+    """Take one gradient L-step over a row segment into ``l_new`` (``Y1 = U - Lh``)."""
+    g1, g2, c = coefficients[0], coefficients[1], coefficients[2]
+    rho1, rho2, step = coefficients[3], coefficients[4], coefficients[5]
+    for i in range(d.size):
+        rhs = rho1 * (u[i] + (u[i] - lh[i])) + rho2 * (d[i] - s[i] - v[i] + y2[i])
+        grad = c * bg[i] - rhs + g1 * spatial[i] + g2 * temporal[i]
+        l_new[i] = bg[i] - step * grad
+
+
+@njit(cache=True, inline='always', fastmath=_FAST)
+def _shrink_steps(d, bg, u, lh, s, v, y2, l_new, s_new, t_s, t_v, sums):
+    """
+    Take the S- and V-steps, ``Y2`` and the next ``Lh`` over a row segment; add up its sums.
+
+    Row segments of one frame are contiguous: the loop has no stride and
+    no aliasing the compiler must rule out, so it vectorises (the pixel-major
+    rows of ``m`` entries were too short for that, docs/solver.md).
+    """
+    d_l = n_l = d_s = n_s = r_u = r_v = np.float32(0.0)
+    for i in range(d.size):
+        dual = u[i] - lh[i]
+        gap = u[i] - bg[i]
+        r_u += gap * gap
+        background = l_new[i]
+        residual = d[i] - background
+        foreground = _shrink(residual - v[i] + y2[i], t_s)
+        noise = _shrink(residual - foreground + y2[i], t_v)
+        gap = residual - foreground - noise
+        y2[i] += gap
+        r_v += gap * gap
+        s_new[i] = foreground
+        v[i] = noise
+        lh[i] = background - dual
+        delta = background - bg[i]
+        d_l += delta * delta
+        n_l += bg[i] * bg[i]
+        delta = foreground - s[i]
+        d_s += delta * delta
+        n_s += s[i] * s[i]
+    sums[0] += d_l
+    sums[1] += n_l
+    sums[2] += d_s
+    sums[3] += n_s
+    sums[4] += r_u
+    sums[5] += r_v
+
+
 @njit(parallel=True, cache=True, fastmath=_FAST, nogil=True)
 def primal_pass(data, L, U, Lh, S, V, Y2,
                 s_offsets, s_bands, t_offsets, t_bands, coefficients, l_given,
                 L_new, S_new):
     """
-    Run one sweep but the SVT, fused, threaded over row blocks.
+    Run one sweep but the SVT, fused, threaded over blocks of pixels.
 
+    Every matrix is **frames-major**, ``(m, n)``: the transpose of the
+    solver's ``n x m`` window, one contiguous row of pixels per frame
+    (:func:`frames_major`). For each block of pixels and each frame ``j``:
+    the L-step (one gradient step into ``L_new``; with ``l_given`` the caller
+    computed ``L_new`` in numpy), the S-step into ``S_new``, and in place the
+    V-step, ``Y2 += D - L - S - V`` and the next SVT input ``Lh = L_new - Y1``.
     The dual ``Y1`` is not stored: after every U-step ``Y1 = U - Lh`` exactly
-    (``Y1 + U - L`` with ``Lh = L - Y1``), so each row reads it from ``U`` and
-    the previous ``Lh``. Per row: the L-step (one gradient step into
-    ``L_new``; with ``l_given`` the caller computed ``L_new`` in numpy), the
-    S-step into ``S_new``, and in place the V-step, ``Y2 += D - L - S - V``
-    and the next SVT input ``Lh = L_new - Y1``. ``L`` and ``S`` keep the
-    previous iterate (the L-step reads neighbouring rows of ``L``; the solver
-    falls back on both when an iterate is not finite). ``coefficients`` =
-    (g1, g2, c, rho1, rho2, step, lam2 / rho2, 1 / rho2) as float64.
+    (``Y1 + U - L`` with ``Lh = L - Y1``). ``L`` and ``S`` keep the previous
+    iterate (the L-step reads neighbouring pixels and frames of ``L``; the
+    solver falls back on both when an iterate is not finite).
+    ``coefficients`` = (g1, g2, c, rho1, rho2, step, lam2 / rho2, 1 / rho2).
+    ``s_bands[k, i] = Phi_s[i, i + s_offsets[k]]`` and
+    ``t_bands[k, j] = Phi_t[j, j + t_offsets[k]]`` (:func:`diagonal_bands`).
 
     Returns the float64 sums ``(||L_new - L||^2, ||L||^2, ||S_new - S||^2,
     ||S||^2, ||U - L||^2, ||D - L_new - S_new - V_new||^2)``: the fifth is the
     previous sweep's primal residual of ``U = L`` (``U`` is that sweep's SVT).
     """
-    n, m = data.shape
-    g1 = np.float32(coefficients[0])
-    g2 = np.float32(coefficients[1])
-    c = np.float32(coefficients[2])
-    rho1 = np.float32(coefficients[3])
-    rho2 = np.float32(coefficients[4])
-    step = np.float32(coefficients[5])
-    t_s = np.float32(coefficients[6])
-    t_v = np.float32(coefficients[7])
-    n_blocks = (n + _BLOCK_ROWS - 1) // _BLOCK_ROWS
+    m, n = data.shape
+    coefficients = coefficients.astype(np.float32)
+    t_s = coefficients[6]
+    t_v = coefficients[7]
+    n_blocks = (n + _BLOCK_PIXELS - 1) // _BLOCK_PIXELS
     sums = np.zeros((n_blocks, 6), dtype=np.float64)
-    reach = 0
-    for k in range(t_offsets.size):
-        reach = max(reach, abs(t_offsets[k]))
     for b in prange(n_blocks):
-        spatial = np.empty(m, dtype=np.float32)
-        temporal = np.empty(m, dtype=np.float32)
-        dual = np.empty(m, dtype=np.float32)
-        # One row of L with ``reach`` zeros either side: the temporal bands
-        # become fixed-length loops (the bands are zero where j + off leaves
-        # the window).
-        padded = np.zeros(m + 2 * reach, dtype=np.float32)
-        d_l = 0.0
-        n_l = 0.0
-        d_s = 0.0
-        n_s = 0.0
-        r_u = 0.0
-        r_v = 0.0
-        for i in range(b * _BLOCK_ROWS, min(n, (b + 1) * _BLOCK_ROWS)):
-            for j in range(m):
-                dual[j] = U[i, j] - Lh[i, j]
-                gap = U[i, j] - L[i, j]
-                r_u += gap * gap
+        lo = b * _BLOCK_PIXELS
+        hi = min(n, lo + _BLOCK_PIXELS)
+        spatial = np.empty(hi - lo, dtype=np.float32)
+        temporal = np.empty(hi - lo, dtype=np.float32)
+        block_sums = np.zeros(6, dtype=np.float64)
+        for j in range(m):
             if not l_given:
-                for j in range(m):
-                    spatial[j] = 0.0
-                    temporal[j] = 0.0
-                    padded[reach + j] = L[i, j]
+                spatial[:] = 0.0
+                temporal[:] = 0.0
                 for k in range(s_offsets.size):
-                    row = i + s_offsets[k]
-                    if 0 <= row < n:
-                        weight = s_bands[k, i]
-                        for j in range(m):
-                            spatial[j] += weight * L[row, j]
+                    # (Phi_s L)[i] = sum_k bands[k, i] L[i + off]; the band is
+                    # zero where i + off leaves the frame, so the range is cut.
+                    off = s_offsets[k]
+                    first = max(lo, -off)
+                    last = min(hi, n - off)
+                    if first < last:
+                        _add_product(s_bands[k, first:last], L[j, first + off:last + off],
+                                     spatial[first - lo:last - lo])
                 for k in range(t_offsets.size):
-                    # (L Phi_t)[i, j] = sum_k L[i, j + off] Phi_t[j + off, j]
-                    #                 = sum_k L[i, j + off] Phi_t[j, j + off] (symmetric).
-                    # Unsigned indices: numba's negative-index wraparound
-                    # check on a signed index stops this loop vectorising (7x).
-                    start = np.uint64(reach + t_offsets[k])
-                    for j in range(m):
-                        temporal[j] += t_bands[k, j] * padded[start + np.uint64(j)]
-                for j in range(m):
-                    rhs = rho1 * (U[i, j] + dual[j]) \
-                        + rho2 * (data[i, j] - S[i, j] - V[i, j] + Y2[i, j])
-                    grad = c * L[i, j] - rhs + g1 * spatial[j] + g2 * temporal[j]
-                    L_new[i, j] = L[i, j] - step * grad
-            for j in range(m):
-                background = L_new[i, j]
-                residual = data[i, j] - background
-                foreground = _shrink(residual - V[i, j] + Y2[i, j], t_s)
-                noise = _shrink(residual - foreground + Y2[i, j], t_v)
-                gap = residual - foreground - noise
-                Y2[i, j] += gap
-                r_v += gap * gap
-                S_new[i, j] = foreground
-                V[i, j] = noise
-                Lh[i, j] = background - dual[j]
-                delta = background - L[i, j]
-                d_l += delta * delta
-                n_l += L[i, j] * L[i, j]
-                delta = foreground - S[i, j]
-                d_s += delta * delta
-                n_s += S[i, j] * S[i, j]
-        sums[b, 0] = d_l
-        sums[b, 1] = n_l
-        sums[b, 2] = d_s
-        sums[b, 3] = n_s
-        sums[b, 4] = r_u
-        sums[b, 5] = r_v
+                    # (L Phi_t)[j] = sum_k L[j + off] Phi_t[j + off, j], Phi_t symmetric.
+                    other = j + t_offsets[k]
+                    if 0 <= other < m:
+                        _add_scaled(t_bands[k, j], L[other, lo:hi], temporal)
+                _gradient_step(data[j, lo:hi], L[j, lo:hi], U[j, lo:hi], Lh[j, lo:hi],
+                               S[j, lo:hi], V[j, lo:hi], Y2[j, lo:hi], spatial, temporal,
+                               L_new[j, lo:hi], coefficients)
+            _shrink_steps(data[j, lo:hi], L[j, lo:hi], U[j, lo:hi], Lh[j, lo:hi], S[j, lo:hi],
+                          V[j, lo:hi], Y2[j, lo:hi], L_new[j, lo:hi], S_new[j, lo:hi],
+                          t_s, t_v, block_sums)
+        sums[b] = block_sums
     return sums.sum(axis=0)
 
 
 @njit(parallel=True, cache=True, fastmath=_FAST, nogil=True)
 def squared_gap(a, b):
-    """Return ``||a - b||_F^2`` in float64, threaded over row blocks."""
-    n = a.shape[0]
-    n_blocks = (n + _BLOCK_ROWS - 1) // _BLOCK_ROWS
+    """Return ``||a - b||_F^2`` of two C-contiguous arrays in float64, threaded over blocks."""
+    a = a.ravel()
+    b = b.ravel()
+    n = a.size
+    n_blocks = (n + _BLOCK_PIXELS - 1) // _BLOCK_PIXELS
     sums = np.zeros(n_blocks, dtype=np.float64)
     for blk in prange(n_blocks):
-        total = 0.0
-        for i in range(blk * _BLOCK_ROWS, min(n, (blk + 1) * _BLOCK_ROWS)):
-            for j in range(a.shape[1]):
-                gap = a[i, j] - b[i, j]
-                total += gap * gap
+        total = np.float32(0.0)
+        for i in range(blk * _BLOCK_PIXELS, min(n, (blk + 1) * _BLOCK_PIXELS)):
+            gap = a[i] - b[i]
+            total += gap * gap
         sums[blk] = total
     return sums.sum()
+
+
+def frames_major(matrix):
+    """
+    Return the ``(m, n)`` C-contiguous transpose of a float32 window ``matrix`` (n, m).
+
+    No copy when ``matrix`` already is such a transpose (an F-ordered
+    ``n x m`` array, as the fused solver's state is); else a blocked
+    transpose (:func:`~dgmod_ros.core.linalg.c_order`).
+    """
+    return c_order(np.asarray(matrix, dtype=np.float32).T)
 
 
 def compile_all():

@@ -2,6 +2,7 @@
 # Licensed under the Apache License, Version 2.0
 """Small dense linear-algebra kernels shared by every solver in the core."""
 
+import cv2
 import numpy as np
 
 
@@ -18,7 +19,7 @@ def shrink(x, threshold, out=None):
     return np.subtract(x, clipped, out=out)
 
 
-def gram_eigh(matrix, vectors=True):
+def gram_eigh(matrix, vectors=True, gram=None):
     """
     Return the singular values (descending) and right singular vectors of a tall matrix.
 
@@ -27,17 +28,19 @@ def gram_eigh(matrix, vectors=True):
     has the measured difference). Accurate for singular values above about
     ``1e-6 sigma_max``; every caller thresholds smaller ones away. With
     ``vectors=False`` only the singular values are computed (and returned).
+    ``gram``: ``(matrix.T @ matrix)`` in float64 where the caller has it.
     """
-    gram = (matrix.T @ matrix).astype(np.float64)
+    if gram is None:
+        gram = (matrix.T @ matrix).astype(np.float64)
     if not vectors:
         return np.sqrt(np.clip(np.linalg.eigvalsh(gram)[::-1], 0.0, None))
     eigval, eigvec = np.linalg.eigh(gram)
     return np.sqrt(np.clip(eigval[::-1], 0.0, None)), eigvec[:, ::-1]
 
 
-def top_singular_value(matrix):
-    """Return the largest singular value (the spectral norm) of a tall matrix."""
-    return float(gram_eigh(matrix, vectors=False)[0])
+def top_singular_value(matrix, gram=None):
+    """Return the largest singular value of a tall matrix (``gram``: see :func:`gram_eigh`)."""
+    return float(gram_eigh(matrix, vectors=False, gram=gram)[0])
 
 
 def mixing_factors(gram, transform):
@@ -95,6 +98,23 @@ def thin_svd(matrix, rank=None, rtol=1e-6):
     sigma, right = sigma[keep], right[:, keep]
     left = matrix @ (right / sigma).astype(matrix.dtype)
     return left, sigma.astype(matrix.dtype), right.astype(matrix.dtype)
+
+
+def c_order(matrix):
+    """
+    Return a 2-D float32 array in C order, by OpenCV's blocked transpose when it is F-ordered.
+
+    The fused solver's iterates are F-ordered (``n x m`` views of frames-major
+    arrays, :func:`~dgmod_ros.core.kernels.frames_major`); numpy's strided
+    transpose of such a tall matrix took ten times as long as a copy, and
+    OpenCV's about twice (docs/solver.md).
+    """
+    matrix = np.asarray(matrix, dtype=np.float32)
+    if matrix.flags.c_contiguous:
+        return matrix
+    if matrix.flags.f_contiguous:
+        return cv2.transpose(matrix.T)
+    return np.ascontiguousarray(matrix)
 
 
 def relative_change(new, old):

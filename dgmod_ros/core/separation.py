@@ -7,6 +7,8 @@ import time
 
 import numpy as np
 
+from .linalg import c_order
+
 
 @dataclass
 class ChannelSeparation:
@@ -75,7 +77,8 @@ def separate_channels(model, data, frame_shape, inits=None):
         background = np.asarray(fitted.background_, dtype=np.float32)
         backgrounds.append(background)
         foregrounds.append(np.asarray(fitted.foreground_, dtype=np.float32))
-        np.subtract(data[channel], background, out=residuals[channel])
+        # The fused solver's L is F-ordered; D - L in one memory order.
+        np.subtract(data[channel], c_order(background), out=residuals[channel])
         states.append(getattr(fitted, 'state_', None))
         iterations = max(iterations, int(getattr(fitted, 'n_iter_', 0)))
         info = max(info, int(getattr(fitted, 'info_', 0)))
