@@ -4,14 +4,14 @@
 
 import cv2
 from dgmod_ros.core.preprocess import frame_columns
-from dgmod_ros.core.streaming import mean_field_kernel
+from dgmod_ros.core.streaming import lighting_kernel, mean_field_kernel
 from dgmod_ros.core.streaming.blobs import BlobMotion, moving_share_reference
 from dgmod_ros.core.streaming.coherence import mean_field_mask, mean_field_mask_reference
 from dgmod_ros.core.streaming.foreground import (_edge_strength, ghost_blobs, ghost_labels,
-                                                 to_input_size)
+                                                 observed_median, to_input_size)
 from dgmod_ros.core.streaming.held_foreground import still_blob_pixels
 from dgmod_ros.core.streaming.lighting_kernel import explained_pixels
-from dgmod_ros.core.streaming.photometric import LightingTest
+from dgmod_ros.core.streaming.photometric import distortion, LightingTest
 import numpy as np
 import pytest
 
@@ -192,3 +192,23 @@ def test_bgr_frames_give_the_columns_of_their_channels_reversed(dtype, channels)
         got, shape = frame_columns(image, scale, 'rgb', 'bgr')
         expected, expected_shape = frame_columns(reference, scale, 'rgb', 'rgb')
         assert shape == expected_shape and np.array_equal(got, expected)
+
+
+@pytest.mark.parametrize('seed', range(4))
+def test_window_chroma_kernel_gives_numpy_distortion(seed):
+    rng = np.random.default_rng(seed)
+    data = rng.random((3, 500, 7), dtype=np.float32)
+    data[:, :20] *= np.float32(1e-4)                    # dark pixels: the energy floor
+    residual = rng.normal(0, 0.05, data.shape).astype(np.float32)
+    _, expected = distortion(data, data - residual)
+    assert np.array_equal(lighting_kernel.window_chroma(data, residual), expected)
+    assert lighting_kernel.window_chroma(data.astype(np.float64), residual) is None
+
+
+@pytest.mark.parametrize('columns', [29, 30])
+def test_median_of_fully_observed_rows_is_numpys(columns):
+    magnitude = np.abs(np.random.default_rng(columns).normal(0, 0.02, (400, columns)))
+    magnitude = magnitude.astype(np.float32)
+    median, count = observed_median(magnitude)
+    assert median.dtype == np.float32 and np.array_equal(median, np.median(magnitude, axis=1))
+    assert np.all(count == columns)

@@ -45,6 +45,29 @@ _QUANTUM = 1.0 / 255.0
 _GHOST_MOVING_SHARE = 0.1
 
 
+def observed_median(magnitude, observed=None):
+    """
+    Return each row's median (n,) over its observed entries, and their count (n,).
+
+    With ``observed`` None, numpy's median of the whole row (the mean of the
+    middle two for an even count), taken from a sort: ``np.median`` along the
+    short rows of an (n, m) array is about 4x slower. Otherwise the lower
+    median of the observed entries. The magnitudes are finite (a solve's
+    residual), so sorting and ``np.median`` agree.
+    """
+    if observed is None:
+        ordered = np.sort(magnitude, axis=1)
+        columns = magnitude.shape[1]
+        half = columns // 2
+        median = (ordered[:, half] if columns % 2
+                  else (ordered[:, half - 1] + ordered[:, half]) / np.float32(2))
+        return median, np.full(magnitude.shape[0], columns)
+    # Unobserved entries sort last.
+    ordered = np.sort(np.where(observed, magnitude, np.inf), axis=1)
+    count = np.count_nonzero(observed, axis=1)
+    return ordered[np.arange(ordered.shape[0]), np.maximum(count - 1, 0) // 2], count
+
+
 def pixel_noise(residual, shape, observed=None, uniform=False):
     """
     Return each pixel's noise level ``sigma_p`` (n,) float32 from a window's residual.
@@ -63,14 +86,7 @@ def pixel_noise(residual, shape, observed=None, uniform=False):
     """
     rows, cols = shape[:2]
     magnitude = np.abs(residual).max(axis=0)                     # (n, m)
-    if observed is None:
-        median = np.median(magnitude, axis=1)
-        count = np.full(magnitude.shape[0], magnitude.shape[1])
-    else:
-        # Median over each pixel's observed columns: unobserved entries sort last.
-        ordered = np.sort(np.where(observed, magnitude, np.inf), axis=1)
-        count = np.count_nonzero(observed, axis=1)
-        median = ordered[np.arange(ordered.shape[0]), np.maximum(count - 1, 0) // 2]
+    median, count = observed_median(magnitude, observed)
     sigma = _MAD_TO_SIGMA * median
     seen = count >= MIN_OBSERVED
     typical = float(np.median(sigma[seen])) if np.any(seen) else robust_sigma(magnitude)

@@ -13,7 +13,8 @@ distance cannot change the answer). The arithmetic is the reference's in
 float32, operation for operation (``einsum``'s sums of products add the
 channels in order, with no fused multiply-add; Python scalars enter numpy's
 arithmetic as float32), so the answers are the same bit for bit; inputs of
-another type go to the reference.
+another type go to the reference. :func:`window_chroma` is the same
+chromaticity arithmetic over a whole window (the solve's chromaticity levels).
 
 Importing :mod:`dgmod_ros.core.kernels` first (through
 :mod:`~dgmod_ros.core.streaming.texture`) makes its process-wide numba
@@ -102,8 +103,43 @@ def explained_pixels(test, columns, background, noise, k, shape, candidates, chr
     return explained
 
 
+@njit(cache=True, nogil=True)
+def _window_chroma(data, residual, chroma):
+    channels, count, columns = data.shape
+    for i in range(count):
+        for j in range(columns):
+            energy = np.float32(0.0)
+            dot = np.float32(0.0)
+            for c in range(channels):
+                background = data[c, i, j] - residual[c, i, j]
+                energy += background * background
+                dot += data[c, i, j] * background
+            alpha = dot / _nan_maximum(energy, _DARK)
+            across = np.float32(0.0)
+            for c in range(channels):
+                difference = data[c, i, j] - alpha * (data[c, i, j] - residual[c, i, j])
+                across += difference * difference
+            chroma[i, j] = math.sqrt(across)
+
+
+def window_chroma(data, residual):
+    """
+    Return the chromaticity distortion (n, m) float32 of a window against ``D - residual``.
+
+    :func:`~dgmod_ros.core.streaming.photometric.distortion`'s second output
+    for ``(data, data - residual)`` in one pass, without its (C, n, m)
+    temporaries; None for inputs that are not float32 (the caller runs numpy).
+    """
+    if data.dtype != np.float32 or residual.dtype != np.float32:
+        return None
+    chroma = np.empty(data.shape[1:], dtype=np.float32)
+    _window_chroma(data, residual, chroma)
+    return chroma
+
+
 def compile_kernel():
-    """Compile (or load from the cache) the pass on a tiny input."""
+    """Compile (or load from the cache) the passes on a tiny input."""
+    window_chroma(np.ones((3, 4, 2), dtype=np.float32), np.zeros((3, 4, 2), dtype=np.float32))
     from .photometric import LightingTest
     frame = np.linspace(0.1, 0.9, 3 * 30, dtype=np.float32).reshape(3, 30)
     LightingTest().explains(frame, frame * np.float32(0.9), 0.01, 6.0, (5, 6, 3),

@@ -84,7 +84,10 @@ def chroma_noise(data, residual, shape, observed=None, uniform=False):
         Give every pixel the typical level.
 
     """
-    _, chroma = distortion(data, data - residual)
+    from .lighting_kernel import window_chroma     # numba: loaded on first use
+    chroma = window_chroma(data, residual)
+    if chroma is None:
+        _, chroma = distortion(data, data - residual)
     return pixel_noise(chroma[None], shape, observed, uniform)
 
 
