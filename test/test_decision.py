@@ -301,20 +301,3 @@ def test_the_window_keeps_out_what_passes_under_the_threshold():
     # The column admitted at frame 39, when the box covered columns 39-46.
     assert not _newest_column_observed(True)[12:28, 41:45].any()
     assert _newest_column_observed(False)[12:28, 41:45].all()
-
-
-def test_the_window_keeps_out_foreground_while_it_fills():
-    # A dark box crossing the first frames: from the first model on, the
-    # columns of the fill hold the background where the box is.
-    rng = np.random.default_rng(7)
-    wall = rng.uniform(0.3, 0.9, (40, 60, 3)).astype(np.float32)
-    detector = SlidingWindowDetector(scale=1.0, ghost_test=False, still_frames=0)
-    for index in range(16):
-        image = wall + rng.normal(0, 0.004, wall.shape).astype(np.float32)
-        image[10:30, 2 * index:2 * index + 8] = 0.05
-        result, _ = detector.process(np.clip(image, 0, 1))
-    assert len(detector.buffer_) < detector.buffer_.capacity        # still filling
-    assert result.mask[12:28, 32:36].all()
-    observed = detector.buffer_.observed()
-    assert observed is not None
-    assert not observed[:, -1].reshape(40, 60)[12:28, 32:36].any()

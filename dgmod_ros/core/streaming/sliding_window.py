@@ -412,11 +412,11 @@ class SlidingWindowDetector(StreamingDetector):
                 or self.buffer_.is_motionless(columns, self.motion_threshold)):
             return False
         observed = None
-        # From the first model on, also while the window fills: the frames of
-        # the fill stay in the window for window * memory_spacing frames, and
-        # a slow walker admitted in them as he is makes his pixels' window
-        # residual, hence their noise level, his own (docs/results.md).
-        if self.conditional_update and self.background_model_ is not None:
+        # While the window fills, every frame goes in as it is: the first
+        # solves must separate whatever moves in the first frames, and a
+        # model learnt from a few frames is no ground for holding pixels back.
+        if (self.conditional_update and self.background_model_ is not None
+                and len(self.buffer_) >= self.buffer_.capacity):
             held = foreground
             if self.hold_changes and self.decision != 'global':
                 held = self._held(columns, foreground, distance, level)
