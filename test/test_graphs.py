@@ -1,7 +1,8 @@
 # Copyright 2026 dgmod_ros authors
 # Licensed under the Apache License, Version 2.0
-from dgmod_ros.core.graphs import (banded_matrix, data_gram, spatial_laplacian,
-                                   spatial_laplacian_bands, temporal_laplacian)
+from dgmod_ros.core.graphs import (banded_matrix, spatial_laplacian, spatial_laplacian_bands,
+                                   temporal_laplacian)
+from dgmod_ros.core.linalg import gram_matrix
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -83,7 +84,7 @@ def test_temporal_laplacian_from_a_given_gram_is_the_same(window):
     # The solver computes D^T D once for Phi_t and the weights' scale.
     data, _ = window
     alone, h_alone = temporal_laplacian(data, neighbors=4)
-    shared, h_shared = temporal_laplacian(data, neighbors=4, gram=data_gram(data))
+    shared, h_shared = temporal_laplacian(data, neighbors=4, gram=gram_matrix(data))
     assert h_alone == h_shared
     assert np.array_equal(alone.toarray(), shared.toarray())
 

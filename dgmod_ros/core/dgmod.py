@@ -6,9 +6,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .graphs import banded_matrix, data_gram, spatial_laplacian_bands, temporal_laplacian
-from .linalg import (drop_oldest, gram_eigh, mixing_factors, relative_change, shrink,
-                     singular_value_map, top_singular_value)
+from .graphs import banded_matrix, spatial_laplacian_bands, temporal_laplacian
+from .linalg import (drop_oldest, gram_eigh, gram_matrix, mixing_factors, relative_change,
+                     shrink, singular_value_map, top_singular_value)
 from .runtime import limit_blas_threads
 from .window_data import check_window_data
 
@@ -481,7 +481,7 @@ class DualGraphMOD:
         """
         offsets, bands, self.h_s_ = spatial_laplacian_bands(
             data, frame_shape, self.patch_size, self.h_s, self.smoothing_sigma)
-        gram = data_gram(data)
+        gram = gram_matrix(data)
         phi_t, self.h_t_ = temporal_laplacian(data, self.temporal_neighbors, self.h_t, gram)
         mu, basis = np.linalg.eigh(phi_t.toarray())
         return _Operators(phi_s_bands=(offsets, bands), phi_t=phi_t.astype(np.float32).toarray(),

@@ -15,6 +15,8 @@ import numpy as np
 from scipy import ndimage
 import scipy.sparse as sp
 
+from .linalg import gram_matrix
+
 
 def normalized_laplacian(adjacency):
     """
@@ -66,7 +68,7 @@ def temporal_laplacian(data, neighbors=4, h=None, gram=None):
     """
     m = data.shape[1]
     if gram is None:
-        gram = data_gram(data)
+        gram = gram_matrix(data)
     sq_norm = np.diag(gram)
     reach = max(1, neighbors // 2)
     rows, cols = [], []
@@ -82,11 +84,6 @@ def temporal_laplacian(data, neighbors=4, h=None, gram=None):
     adjacency = sp.coo_matrix((np.r_[weights, weights], (np.r_[rows, cols], np.r_[cols, rows])),
                               shape=(m, m))
     return normalized_laplacian(adjacency), h_used
-
-
-def data_gram(data):
-    """Return ``data.T @ data`` (m x m) in float64, from the float32 product."""
-    return (data.T @ data).astype(np.float64)
 
 
 def _box_sum(image, patch_size):

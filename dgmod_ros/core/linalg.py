@@ -19,6 +19,11 @@ def shrink(x, threshold, out=None):
     return np.subtract(x, clipped, out=out)
 
 
+def gram_matrix(matrix):
+    """Return ``matrix.T @ matrix`` in float64, from the product in the matrix's own type."""
+    return (matrix.T @ matrix).astype(np.float64)
+
+
 def gram_eigh(matrix, vectors=True, gram=None):
     """
     Return the singular values (descending) and right singular vectors of a tall matrix.
@@ -31,7 +36,7 @@ def gram_eigh(matrix, vectors=True, gram=None):
     ``gram``: ``(matrix.T @ matrix)`` in float64 where the caller has it.
     """
     if gram is None:
-        gram = (matrix.T @ matrix).astype(np.float64)
+        gram = gram_matrix(matrix)
     if not vectors:
         return np.sqrt(np.clip(np.linalg.eigvalsh(gram)[::-1], 0.0, None))
     eigval, eigvec = np.linalg.eigh(gram)
