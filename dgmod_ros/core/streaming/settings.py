@@ -20,32 +20,36 @@ def check_scale_and_color(scale, color):
         raise ValueError(f"color must be 'gray' or 'rgb', got {color!r}")
 
 
+def _require_integer(name, value, low, high=None, high_label=None):
+    """Raise ``ValueError`` unless ``value`` is an integer in ``[low, high]`` (None: no bound)."""
+    if int(value) == value and low <= value and (high is None or value <= high):
+        return
+    if high is None:
+        raise ValueError(f'{name} must be an integer >= {low}, got {value!r}')
+    raise ValueError(f'{name} must be an integer in [{low}, {high_label or high}], '
+                     f'got {value!r}')
+
+
+def _require_non_negative(name, value):
+    """Raise ``ValueError`` unless ``value`` is a finite number >= 0."""
+    if not (np.isfinite(value) and value >= 0):
+        raise ValueError(f'{name} must be >= 0, got {value!r}')
+
+
 def check_window_parameters(detector):
     """Raise ``ValueError`` naming the first bad parameter of a sliding-window detector."""
     window, stride = detector.window, detector.stride
-    if int(window) != window or window < 2:
-        raise ValueError(f'window must be an integer >= 2, got {window!r}')
-    if int(stride) != stride or not 1 <= stride <= window:
-        raise ValueError(f'stride must be an integer in [1, window={window}], got {stride!r}')
+    _require_integer('window', window, 2)
+    _require_integer('stride', stride, 1, window, f'window={window}')
     check_scale_and_color(detector.scale, detector.color)
-    if not (np.isfinite(detector.motion_threshold) and detector.motion_threshold >= 0):
-        raise ValueError(f'motion_threshold must be >= 0, got {detector.motion_threshold!r}')
-    min_frames = detector.min_frames
-    if int(min_frames) != min_frames or not 2 <= min_frames <= window:
-        raise ValueError(f'min_frames must be an integer in [2, window={window}], '
-                         f'got {min_frames!r}')
+    _require_non_negative('motion_threshold', detector.motion_threshold)
+    _require_integer('min_frames', detector.min_frames, 2, window, f'window={window}')
     if not 0 < detector.global_change_fraction <= 1:
         raise ValueError(f'global_change_fraction must be in (0, 1], got '
                          f'{detector.global_change_fraction!r}')
-    rank = detector.basis_rank
-    if int(rank) != rank or rank < 1:
-        raise ValueError(f'basis_rank must be a positive integer, got {rank!r}')
-    spacing = detector.memory_spacing
-    if int(spacing) != spacing or spacing < 1:
-        raise ValueError(f'memory_spacing must be a positive integer, got {spacing!r}')
-    absorb = detector.absorb_frames
-    if int(absorb) != absorb or absorb < 1:
-        raise ValueError(f'absorb_frames must be a positive integer, got {absorb!r}')
+    _require_integer('basis_rank', detector.basis_rank, 1)
+    _require_integer('memory_spacing', detector.memory_spacing, 1)
+    _require_integer('absorb_frames', detector.absorb_frames, 1)
     if detector.decision not in ('adaptive', 'uniform', 'global'):
         raise ValueError(f"decision must be 'adaptive', 'uniform' or 'global', "
                          f'got {detector.decision!r}')
@@ -57,25 +61,13 @@ def check_window_parameters(detector):
     size = detector.median_size
     if int(size) != size or size < 1 or size % 2 == 0:
         raise ValueError(f'median_size must be an odd positive integer, got {size!r}')
-    still = detector.still_frames
-    if int(still) != still or still < 0:
-        raise ValueError(f'still_frames must be an integer >= 0, got {still!r}')
-    if not (np.isfinite(detector.mrf_beta) and detector.mrf_beta >= 0):
-        raise ValueError(f'mrf_beta must be >= 0, got {detector.mrf_beta!r}')
-    bits = detector.texture_bits
-    if int(bits) != bits or not 0 <= bits <= 48:
-        raise ValueError(f'texture_bits must be an integer in [0, 48], got {bits!r}')
-    if not (np.isfinite(detector.moving_texture_k) and detector.moving_texture_k >= 0):
-        raise ValueError(f'moving_texture_k must be >= 0, got {detector.moving_texture_k!r}')
-    bits = detector.moving_texture_bits
-    if int(bits) != bits or not 0 <= bits <= 48:
-        raise ValueError(f'moving_texture_bits must be an integer in [0, 48], got {bits!r}')
-    lag = detector.solve_lag
-    if int(lag) != lag or not 0 <= lag <= stride:
-        raise ValueError(f'solve_lag must be an integer in [0, stride={stride}], got {lag!r}')
-    pixels = detector.solve_pixels
-    if int(pixels) != pixels or pixels < 1:
-        raise ValueError(f'solve_pixels must be a positive integer, got {pixels!r}')
+    _require_integer('still_frames', detector.still_frames, 0)
+    _require_non_negative('mrf_beta', detector.mrf_beta)
+    _require_integer('texture_bits', detector.texture_bits, 0, 48)
+    _require_non_negative('moving_texture_k', detector.moving_texture_k)
+    _require_integer('moving_texture_bits', detector.moving_texture_bits, 0, 48)
+    _require_integer('solve_lag', detector.solve_lag, 0, stride, f'stride={stride}')
+    _require_integer('solve_pixels', detector.solve_pixels, 1)
     (detector.mask_rule or MaskRule()).validate()
 
 
