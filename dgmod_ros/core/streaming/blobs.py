@@ -29,9 +29,9 @@ from .. import kernels  # noqa: F401
 
 
 @njit(cache=True, nogil=True)
-def _moving_counts(labels, frame, earlier, noise, multiples, pixels, moved):
+def _moving_counts(labels, frame, earlier, noise, k, pixels, moved):
     """
-    Count each label's pixels and those whose change exceeds each multiple of the noise level.
+    Count each label's pixels and those whose change exceeds ``k`` noise levels.
 
     A change is the largest absolute difference over the channels (NaN in
     any channel: no change, as numpy's ``max`` then ``>``).
@@ -50,10 +50,8 @@ def _moving_counts(labels, frame, earlier, noise, multiples, pixels, moved):
                 finite = False
             elif value > change:
                 change = value
-        if finite:
-            for m in range(multiples.shape[0]):
-                if change > multiples[m] * noise[i]:
-                    moved[m, label] += 1
+        if finite and change > k * noise[i]:
+            moved[label] += 1
 
 
 class BlobMotion:
@@ -100,11 +98,11 @@ class BlobMotion:
                 and noise.dtype == np.float32 and noise.size == self.labels.size
                 and frame.dtype == np.float32 and earlier.dtype == np.float32):
             pixels = np.zeros(self.count, dtype=np.int64)
-            moved = np.zeros((1, self.count), dtype=np.int64)
+            moved = np.zeros(self.count, dtype=np.int64)
             _moving_counts(self.labels.reshape(-1), np.ascontiguousarray(frame),
                            np.ascontiguousarray(earlier), np.ascontiguousarray(noise.ravel()),
-                           np.array([k], dtype=np.float32), pixels, moved)
-            return moved[0] / np.maximum(pixels, 1)
+                           np.float32(k), pixels, moved)
+            return moved / np.maximum(pixels, 1)
         return moving_share_reference(self.labels, self.count, frame, earlier, noise, k)
 
     def pixels(self, flags):
