@@ -112,6 +112,12 @@ PARAMETERS = (
               'larger processing size is solved scaled down to this, same aspect, and its '
               "full-size background carried from the solve's temporal factors (76800 = 320 x "
               '240, a 640 x 480 camera at scale 0.5)', 64, 100000000),
+    Parameter('solve_scale', 0.5, 'scale of the window solve against the processing size '
+              '(before the solve_pixels cap); the full-size background is fit from the '
+              "solve's temporal factors", 0.05, 1.0),
+    Parameter('refit_background', True, "the background is each pixel's own series fit on "
+              "the solve's leading temporal factors, the solve's foreground held out, also "
+              "when the solve runs at the processing size; false: the solve's own L there"),
     Parameter('stream_max_iter', 5, 'ADMM sweeps per window solve while streaming (node, '
               'stream mode): each solve starts from the last, so sweeps add up over '
               'overlapping windows', 1, 10000),
@@ -277,7 +283,9 @@ def detector_settings(values):
             'texture_cue': values['texture_cue'], 'texture_bits': values['texture_bits'],
             'moving_texture_k': values['moving_texture_k'],
             'moving_texture_bits': values['moving_texture_bits'],
-            'solve_lag': values['solve_lag'], 'solve_pixels': values['solve_pixels']}
+            'solve_lag': values['solve_lag'], 'solve_pixels': values['solve_pixels'],
+            'solve_scale': values['solve_scale'],
+            'refit_background': values['refit_background']}
 
 
 def validate(values):

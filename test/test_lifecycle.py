@@ -157,14 +157,18 @@ def test_compressed_input_gives_the_raw_masks(scene):
     # JPEG (quality 90) changes pixels by a few grey levels; the per-pixel
     # decision (6 noise levels, noise from the window) sees some of that.
     # Measured with the package defaults: IoU with the raw input's masks
-    # after the first window mean 0.90, worst frame 0.80; IoU with the
-    # scene's truth 0.72 against 0.79 for raw input.
+    # after the first window mean 0.96; IoU with the scene's truth 0.81
+    # against 0.78 for raw input, and on no frame more than 0.02 below the
+    # raw input's (the frames where the two differ most, 0.73 apart, are
+    # frames where the raw input's ghost of the first frames heals a frame
+    # later).
     agreement = [iou(a, b) for a, b in zip(jpeg[10:], reference[10:])]
-    assert np.mean(agreement) > 0.85 and np.min(agreement) > 0.75
+    assert np.mean(agreement) > 0.85
     truth = scene.masks[10:]
-    raw_accuracy = np.mean([iou(a, t) for a, t in zip(reference[10:], truth)])
-    jpeg_accuracy = np.mean([iou(a, t) for a, t in zip(jpeg[10:], truth)])
-    assert jpeg_accuracy > raw_accuracy - 0.1
+    raw_accuracy = np.array([iou(a, t) for a, t in zip(reference[10:], truth)])
+    jpeg_accuracy = np.array([iou(a, t) for a, t in zip(jpeg[10:], truth)])
+    assert np.mean(jpeg_accuracy) > np.mean(raw_accuracy) - 0.05
+    assert np.min(jpeg_accuracy - raw_accuracy) > -0.1
 
 
 def test_reset_service_restarts_the_window(scene):

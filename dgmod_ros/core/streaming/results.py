@@ -104,6 +104,7 @@ class WindowSnapshot:
     decision: str = 'global'    # likewise the decision rule ('adaptive' needs pixel noise)
     noise_source: str = 'solve'  # likewise the residual the pixel noise comes from
     solve_shape: tuple = None   # (rows, cols, C) the window is solved at; None: ``shape``
+    refit_background: bool = False  # refit each pixel's series on the solve's factors
 
 
 @dataclass

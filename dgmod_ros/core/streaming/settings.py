@@ -68,6 +68,8 @@ def check_window_parameters(detector):
     _require_integer('moving_texture_bits', detector.moving_texture_bits, 0, 48)
     _require_integer('solve_lag', detector.solve_lag, 0, stride, f'stride={stride}')
     _require_integer('solve_pixels', detector.solve_pixels, 1)
+    if not (isinstance(detector.solve_scale, (int, float)) and 0 < detector.solve_scale <= 1):
+        raise ValueError(f'solve_scale must be in (0, 1], got {detector.solve_scale!r}')
     (detector.mask_rule or MaskRule()).validate()
 
 

@@ -180,6 +180,22 @@ class SlidingWindowDetector(StreamingDetector):
         factors (:mod:`~dgmod_ros.core.streaming.solve_resolution`); the
         default is 320 x 240, the processing size of a 640 x 480 camera at
         the default ``scale``.
+    solve_scale : float, default=0.5
+        Scale in (0, 1] of the window solve against the processing size
+        (before the ``solve_pixels`` cap): the solve fixes the background's
+        temporal factors, which a coarser frame carries as well, and the
+        full-size fit fixes each pixel (``docs/results.md`` has the measured
+        effect); 1 solves at the processing size.
+    refit_background : bool, default=True
+        The window's background is each pixel's own time series fit on the
+        solve's leading ``basis_rank`` temporal factors, the entries the
+        solve called foreground (over 3 noise levels) held out
+        (:func:`~dgmod_ros.core.streaming.solve_resolution.carry_backgrounds`),
+        also when the solve runs at the processing size: a short solve's
+        ``L`` keeps a smear of what moved through the window, and its
+        residual, which sets the noise levels, is then inflated where people
+        passed. False: the solve's own ``L`` where the solve is not scaled
+        down.
 
     Attributes
     ----------
@@ -202,7 +218,7 @@ class SlidingWindowDetector(StreamingDetector):
                  noise_source='solve', pixel_k=6.0, median_size=5, ghost_test=True,
                  still_frames=25, mrf_beta=2.0, chroma_cue=True, texture_cue=True,
                  texture_bits=8, moving_texture_k=3.0, moving_texture_bits=16, solve_lag=0,
-                 solve_pixels=76800):
+                 solve_pixels=76800, solve_scale=0.5, refit_background=True):
         self.model = model
         self.window = window
         self.stride = stride
@@ -231,6 +247,8 @@ class SlidingWindowDetector(StreamingDetector):
         self.moving_texture_bits = moving_texture_bits
         self.solve_lag = solve_lag
         self.solve_pixels = solve_pixels
+        self.solve_scale = solve_scale
+        self.refit_background = refit_background
         self._validated = False
 
     # ------------------------------------------------------------- set-up
@@ -514,7 +532,9 @@ class SlidingWindowDetector(StreamingDetector):
                               observed=self.buffer_.observed(),
                               first_column=self.buffer_.first_column, decision=self.decision,
                               noise_source=self.noise_source,
-                              solve_shape=solve_shape(self.shape_, int(self.solve_pixels)))
+                              solve_shape=solve_shape(self.shape_, int(self.solve_pixels),
+                                                      float(self.solve_scale)),
+                              refit_background=bool(self.refit_background))
 
     def solve(self, snapshot):
         """

@@ -30,15 +30,17 @@ _MAX_CHANNELS = 128
 _HELD_OUT_SIGMAS = 3.0
 
 
-def solve_shape(shape, max_pixels):
+def solve_shape(shape, max_pixels, scale=1.0):
     """
     Return the (rows, cols, C) a window of frames of ``shape`` is solved at.
 
-    ``shape`` itself when a frame has at most ``max_pixels`` pixels; otherwise
-    ``shape`` scaled by one factor in both directions to at most ``max_pixels``
-    pixels (at least 1 x 1), so the rule follows any camera's aspect.
+    ``shape`` scaled by ``scale`` in both directions, and further down, by one
+    factor in both directions, to at most ``max_pixels`` pixels (at least
+    1 x 1), so the rule follows any camera's aspect; ``shape`` itself at
+    ``scale`` 1 when a frame has at most ``max_pixels`` pixels.
     """
     rows, cols = shape[:2]
+    max_pixels = min(max_pixels, int(scale * scale * rows * cols + 1e-6))
     if rows * cols <= max_pixels:
         return tuple(shape)
     factor = np.sqrt(max_pixels / (rows * cols))
@@ -56,6 +58,8 @@ def resample_columns(columns, shape, new_shape, interpolation):
     """
     rows, cols = shape[:2]
     new_rows, new_cols = new_shape[:2]
+    if (rows, cols) == (new_rows, new_cols):
+        return columns
     width = columns.shape[1]
     image = columns.reshape(rows, cols, width)
     out = np.empty((new_rows, new_cols, width), dtype=columns.dtype)

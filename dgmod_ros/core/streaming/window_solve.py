@@ -71,8 +71,11 @@ def solve_window(snapshot):
 
     A snapshot whose ``solve_shape`` is smaller than its frames is solved at
     that size and its full-size background carried from the solve
-    (:mod:`~dgmod_ros.core.streaming.solve_resolution`); the rest (basis,
-    noise levels) is computed at the frames' size either way.
+    (:mod:`~dgmod_ros.core.streaming.solve_resolution`); with
+    ``refit_background`` the background is that fit at any solve size (each
+    pixel's own series on the solve's leading temporal factors, the entries
+    the solve called foreground held out). The rest (basis, noise levels) is
+    computed at the frames' size either way.
 
     Raises
     ------
@@ -82,9 +85,9 @@ def solve_window(snapshot):
     """
     rows, cols, channels = snapshot.shape
     small_shape = _solved_shape(snapshot)
-    carried = small_shape != tuple(snapshot.shape)
+    downscaled = small_shape != tuple(snapshot.shape)
     started = time.perf_counter()
-    data = (downsample_window(snapshot.data, snapshot.shape, small_shape) if carried
+    data = (downsample_window(snapshot.data, snapshot.shape, small_shape) if downscaled
             else snapshot.data)
     try:
         separated = separate_channels(snapshot.model, data, small_shape[:2],
@@ -94,7 +97,7 @@ def solve_window(snapshot):
     backgrounds, residuals = separated.backgrounds, separated.residuals
     if separated.diverged or not all(np.all(np.isfinite(b)) for b in backgrounds):
         raise SolverFailure('window solve produced non-finite values')
-    if carried:
+    if downscaled or snapshot.refit_background:
         backgrounds, residuals = carry_backgrounds(
             snapshot.data, snapshot.shape, backgrounds, residuals, small_shape,
             snapshot.basis_rank)
