@@ -7,9 +7,11 @@ from dgmod_ros import config
 from dgmod_ros.core.dgmod import DualGraphMOD
 from dgmod_ros.core.masks import MaskRule
 from dgmod_ros.core.streaming.fast_path import background_basis
+from dgmod_ros.core.streaming.foreground import pixel_noise
+from dgmod_ros.core.streaming.photometric import chroma_noise
 from dgmod_ros.core.streaming.results import WindowSnapshot
-from dgmod_ros.core.streaming.solve_resolution import (downsample_window, resample_columns,
-                                                       solve_shape)
+from dgmod_ros.core.streaming.solve_resolution import (downsample_window, PixelSample,
+                                                       resample_columns, solve_shape)
 from dgmod_ros.core.streaming.window_solve import solve_window
 from dgmod_ros.core.synthetic import synthetic_scene
 import numpy as np
@@ -35,6 +37,41 @@ def test_resampling_more_columns_than_one_resize_takes():
                        interpolation=cv2.INTER_LINEAR)
     assert up.shape == (FULL[0] * FULL[1], 300)
     assert np.allclose(up[:, 200], alone.ravel())
+
+
+def test_pixel_sample_picks_one_full_size_pixel_per_solved_one():
+    sample = PixelSample((48, 64, 3), (24, 32, 3))
+    # At half size, the lower right pixel of each 2 x 2 block of the area averaging.
+    assert np.array_equal(sample.pixels[:3], [65, 67, 69])
+    assert sample.pixels[-1] == 48 * 64 - 1
+    odd = PixelSample((256, 384), (226, 339))      # CAVIAR's aspect, not an integer ratio
+    assert odd.pixels.size == 226 * 339 == np.unique(odd.pixels).size
+    assert odd.pixels.max() < 256 * 384
+
+
+def test_noise_levels_read_at_the_sample_and_upsampled_match_every_pixels():
+    rng = np.random.default_rng(5)
+    shape, m = (48, 64, 3), 30
+    level = np.tile(np.linspace(0.01, 0.04, shape[1], dtype=np.float32), (shape[0], 1))
+    level[10:30, 8:24] = 0.08                          # a noisy patch (leaves, a screen)
+    residual = (rng.normal(0.0, 1.0, (3, level.size, m)) * level.reshape(1, -1, 1)
+                ).astype(np.float32)
+    residual[:, :, :5] += np.float32(0.5) * (rng.random((1, level.size, 5)) < 0.2)  # movers
+    data = (0.5 + rng.uniform(0.0, 0.2, (3, level.size, 1)) + residual).astype(np.float32)
+    sample = PixelSample(shape, (24, 32, 3))
+    pairs = (
+        (pixel_noise(residual, shape),
+         pixel_noise(sample.take(residual), shape, sample=sample)),
+        (chroma_noise(data, residual, shape),
+         chroma_noise(sample.take(data), sample.take(residual), shape, sample=sample)),
+    )
+    for every, sampled in pairs:
+        assert sampled.shape == every.shape == (level.size,) and sampled.dtype == np.float32
+        error = np.abs(sampled - every) / every
+        # Measured: median 0.9% / 1.4%, 90th percentile 4.9% / 6.0%, largest 13% / 12%.
+        assert np.median(error) < 0.03
+        assert np.percentile(error, 90) < 0.1
+        assert error.max() < 0.25
 
 
 def _low_rank_window(m=24, seed=3):

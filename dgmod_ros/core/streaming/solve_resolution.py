@@ -73,6 +73,48 @@ def downsample_window(data, shape, small_shape):
                      for channel in data])
 
 
+class PixelSample:
+    """
+    One full-size pixel for each pixel of the solve's grid: where a carried window's noise is read.
+
+    A noise level is a median over the window's columns at each pixel, as
+    costly at 640 x 480 as the solve itself once that is capped. Read at the
+    full-size pixel nearest each solve-size pixel's centre (a picked pixel,
+    not an area average, whose noise would be lower by the averaging), the
+    levels are those of full-size pixels, upsampled bilinearly; they are
+    smoothed over 5 x 5 pixels afterwards anyway
+    (:func:`~dgmod_ros.core.streaming.foreground.pixel_noise`).
+
+    Parameters
+    ----------
+    shape, small_shape : tuple (rows, cols, ...)
+        Full and solve frame sizes.
+
+    Attributes
+    ----------
+    pixels : ndarray (k,) intp
+        Row-major full-size indices of the picked pixels, in the solve grid's order.
+
+    """
+
+    def __init__(self, shape, small_shape):
+        self.shape, self.small_shape = tuple(shape[:2]), tuple(small_shape[:2])
+        (rows, cols), (small_rows, small_cols) = self.shape, self.small_shape
+        picked_rows = ((np.arange(small_rows) + 0.5) * (rows / small_rows)).astype(np.intp)
+        picked_cols = ((np.arange(small_cols) + 0.5) * (cols / small_cols)).astype(np.intp)
+        self.pixels = (np.minimum(picked_rows, rows - 1)[:, None] * cols
+                       + np.minimum(picked_cols, cols - 1)[None, :]).ravel()
+
+    def take(self, array):
+        """Return ``array``'s picked pixels: its second-to-last axis, (n, m) or (C, n, m)."""
+        return np.take(array, self.pixels, axis=-2)
+
+    def upsample(self, levels):
+        """Return (n,) float32 levels bilinearly upsampled from one per picked pixel (k,)."""
+        small = np.asarray(levels, dtype=np.float32).reshape(self.small_shape)
+        return cv2.resize(small, self.shape[::-1], interpolation=cv2.INTER_LINEAR).ravel()
+
+
 def carry_backgrounds(data, shape, backgrounds, small_residuals, small_shape, rank):
     """
     Return the full-size backgrounds of a window solved at ``small_shape``, and ``D - L``.

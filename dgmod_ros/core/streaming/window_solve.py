@@ -10,7 +10,7 @@ from .fast_path import background_basis, projection_residual
 from .foreground import pixel_noise
 from .photometric import chroma_noise
 from .results import BackgroundModel, SolverFailure
-from .solve_resolution import carry_backgrounds, downsample_window
+from .solve_resolution import carry_backgrounds, downsample_window, PixelSample
 from ..separation import separate_channels
 
 
@@ -43,25 +43,29 @@ def warm_starts(snapshot):
     return [state.shifted(shift) for state in previous.states]
 
 
-def window_noise(snapshot, residuals, basis):
+def window_noise(snapshot, residuals, basis, sample=None):
     """
     Return each pixel's noise level from the residual ``snapshot.noise_source`` names.
 
     'solve': the solve's ``D - L``; 'projection' / 'least_squares': each
     column against its robust / least-squares projection on the fast path's
     basis (the statistic the per-frame decision thresholds); 'max': the
-    larger of the 'solve' and 'projection' levels.
+    larger of the 'solve' and 'projection' levels. With a
+    :class:`~.solve_resolution.PixelSample`, the levels are read at its
+    pixels (``residuals`` holds those only) and upsampled.
     """
     uniform = snapshot.decision == 'uniform'
     source = snapshot.noise_source
+    take = (lambda array: array) if sample is None else sample.take
+    observed = None if snapshot.observed is None else take(snapshot.observed)
 
     def level(residual):
-        return pixel_noise(residual, snapshot.shape, snapshot.observed, uniform=uniform)
+        return pixel_noise(residual, snapshot.shape, observed, uniform=uniform, sample=sample)
 
     if source == 'solve':
         return level(residuals)
-    projected = level(projection_residual(basis, snapshot.data,
-                                          robust=source != 'least_squares'))
+    projected = level(take(projection_residual(basis, snapshot.data,
+                                               robust=source != 'least_squares')))
     return np.maximum(projected, level(residuals)) if source == 'max' else projected
 
 
@@ -71,8 +75,10 @@ def solve_window(snapshot):
 
     A snapshot whose ``solve_shape`` is smaller than its frames is solved at
     that size and its full-size background carried from the solve
-    (:mod:`~dgmod_ros.core.streaming.solve_resolution`); the rest (basis,
-    noise levels) is computed at the frames' size either way.
+    (:mod:`~dgmod_ros.core.streaming.solve_resolution`); the basis is
+    computed at the frames' size either way, and the noise levels are read at
+    one full-size pixel per solved one and upsampled
+    (:class:`~.solve_resolution.PixelSample`).
 
     Raises
     ------
@@ -104,10 +110,14 @@ def solve_window(snapshot):
         basis[channel, :, :channel_basis.shape[1]] = channel_basis
     noise = chroma = None
     if snapshot.decision != 'global':
-        noise = window_noise(snapshot, residuals, basis)
+        # A carried solve reads its levels at one full-size pixel per solved one.
+        sample = PixelSample(snapshot.shape, small_shape) if carried else None
+        take = (lambda array: array) if sample is None else sample.take
+        noise = window_noise(snapshot, take(residuals), basis, sample)
         if channels == 3:
-            chroma = chroma_noise(snapshot.data, residuals, snapshot.shape,
-                                  snapshot.observed, snapshot.decision == 'uniform')
+            observed = None if snapshot.observed is None else take(snapshot.observed)
+            chroma = chroma_noise(take(snapshot.data), take(residuals), snapshot.shape,
+                                  observed, snapshot.decision == 'uniform', sample)
     return BackgroundModel(
         basis=basis,
         background=np.stack([b[:, -1] for b in backgrounds], axis=1).reshape(
