@@ -10,8 +10,9 @@ from dgmod_ros.core.streaming.fast_path import background_basis
 from dgmod_ros.core.streaming.foreground import pixel_noise
 from dgmod_ros.core.streaming.photometric import chroma_noise
 from dgmod_ros.core.streaming.results import WindowSnapshot
-from dgmod_ros.core.streaming.solve_resolution import (downsample_window, PixelSample,
-                                                       resample_columns, solve_shape)
+from dgmod_ros.core.streaming.solve_resolution import (carry_backgrounds, downsample_window,
+                                                       PixelSample, resample_columns,
+                                                       solve_shape, solve_spd)
 from dgmod_ros.core.streaming.window_solve import solve_window
 from dgmod_ros.core.synthetic import synthetic_scene
 import numpy as np
@@ -74,6 +75,18 @@ def test_noise_levels_read_at_the_sample_and_upsampled_match_every_pixels():
         assert error.max() < 0.25
 
 
+@pytest.mark.parametrize('r', [1, 2, 3])
+def test_batched_positive_definite_systems_match_numpy(r):
+    rng = np.random.default_rng(r)
+    factor = rng.normal(size=(500, r, r + 2)).astype(np.float32)
+    gram = factor @ factor.transpose(0, 2, 1) + 0.01 * np.eye(r, dtype=np.float32)
+    rhs = rng.normal(size=(500, r)).astype(np.float32)
+    expected = np.linalg.solve(gram.astype(np.float64), rhs[:, :, None].astype(np.float64))
+    x = solve_spd(gram.transpose(1, 2, 0), rhs.T)
+    assert x.shape == (r, 500) and x.dtype == np.float32
+    assert np.allclose(x.T, expected[:, :, 0], rtol=1e-3, atol=1e-3)
+
+
 def _low_rank_window(m=24, seed=3):
     """Return a full-size window (1, n, m): pixel-fine texture, a light ramp, a moving block."""
     rng = np.random.default_rng(seed)
@@ -123,6 +136,25 @@ def test_carried_basis_reproduces_a_full_size_low_rank_background():
     # is held out of the fit, so it does not leak into the background.
     newest = model.background[:, :, 0].ravel()
     assert np.percentile(np.abs(newest - truth[:, -1]), 99) < 0.02
+
+
+def test_carried_factors_give_the_backgrounds_columns_and_residuals():
+    _, data = _low_rank_window()
+    small = downsample_window(data, FULL, HALF)
+    half = DualGraphMOD(tol=1e-4, max_iter=200).fit(small[0], HALF[:2])
+    carry = carry_backgrounds(data, FULL, [half.background_], small - half.background_[None],
+                              HALF, 2)
+    coef, temporal = carry.factors[0]
+    background = coef @ temporal.T                                       # (n, m)
+    assert np.allclose(carry.newest()[:, 0], background[:, -1], atol=1e-6)
+    assert np.allclose(carry.mean()[:, 0], background.mean(axis=1), atol=1e-6)
+    residuals = carry.residuals(data)
+    assert np.allclose(residuals[0], data[0] - background, atol=1e-6)
+    pixels = PixelSample(FULL, HALF).pixels
+    assert np.array_equal(carry.residuals(data, pixels), residuals[:, pixels])
+    # The basis from A (n x r) spans what the SVD of the whole background does.
+    basis = carry.bases(2)[0]
+    assert np.allclose(basis @ (basis.T @ background), background, atol=1e-4)
 
 
 def test_an_uncapped_solve_is_the_solve_at_the_frames_size():

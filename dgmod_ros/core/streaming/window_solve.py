@@ -100,34 +100,41 @@ def solve_window(snapshot):
     backgrounds, residuals = separated.backgrounds, separated.residuals
     if separated.diverged or not all(np.all(np.isfinite(b)) for b in backgrounds):
         raise SolverFailure('window solve produced non-finite values')
+    rank = int(snapshot.basis_rank)
     if carried:
-        backgrounds, residuals = carry_backgrounds(
-            snapshot.data, snapshot.shape, backgrounds, residuals, small_shape,
-            snapshot.basis_rank)
-    bases = [background_basis(b, int(snapshot.basis_rank)) for b in backgrounds]
+        # Factors only: the full-size backgrounds are never formed whole.
+        carry = carry_backgrounds(snapshot.data, snapshot.shape, backgrounds, residuals,
+                                  small_shape, rank)
+        bases, newest, mean = carry.bases(rank), carry.newest(), carry.mean()
+    else:
+        bases = [background_basis(b, rank) for b in backgrounds]
+        newest = np.stack([b[:, -1] for b in backgrounds], axis=1)
+        mean = np.stack([b.mean(axis=1) for b in backgrounds], axis=1)
     basis = np.zeros((channels, rows * cols, max(b.shape[1] for b in bases)), dtype=np.float32)
     for channel, channel_basis in enumerate(bases):
         basis[channel, :, :channel_basis.shape[1]] = channel_basis
-    noise = chroma = None
+    noise = chroma = threshold = None
     if snapshot.decision != 'global':
-        # A carried solve reads its levels at one full-size pixel per solved one.
+        # A carried solve reads its levels at one full-size pixel per solved
+        # one, and needs its residual there only.
         sample = PixelSample(snapshot.shape, small_shape) if carried else None
+        if carried:
+            residuals = carry.residuals(snapshot.data, sample.pixels)
         take = (lambda array: array) if sample is None else sample.take
-        noise = window_noise(snapshot, take(residuals), basis, sample)
+        noise = window_noise(snapshot, residuals, basis, sample)
         if channels == 3:
             observed = None if snapshot.observed is None else take(snapshot.observed)
-            chroma = chroma_noise(take(snapshot.data), take(residuals), snapshot.shape,
+            chroma = chroma_noise(take(snapshot.data), residuals, snapshot.shape,
                                   observed, snapshot.decision == 'uniform', sample)
-    return BackgroundModel(
-        basis=basis,
-        background=np.stack([b[:, -1] for b in backgrounds], axis=1).reshape(
-            rows, cols, channels),
-        mean_background=np.stack([b.mean(axis=1) for b in backgrounds], axis=1).reshape(
-            rows, cols, channels),
+    else:
         # The global rule's threshold costs a median over the whole window; the
         # per-pixel decisions read ``noise`` instead.
-        threshold=(snapshot.mask_rule.estimate_threshold(residuals, snapshot.data)
-                   if snapshot.decision == 'global' else None),
+        if carried:
+            residuals = carry.residuals(snapshot.data)
+        threshold = snapshot.mask_rule.estimate_threshold(residuals, snapshot.data)
+    return BackgroundModel(
+        basis=basis, background=newest.reshape(rows, cols, channels),
+        mean_background=mean.reshape(rows, cols, channels), threshold=threshold,
         shape=snapshot.shape, first_id=snapshot.first_id, last_id=snapshot.last_id,
         states=separated.states, seconds=time.perf_counter() - started,
         iterations=separated.iterations, info=separated.info, ticket=snapshot.ticket,
