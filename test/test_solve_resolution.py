@@ -38,6 +38,13 @@ def test_resampling_more_columns_than_one_resize_takes():
                        interpolation=cv2.INTER_LINEAR)
     assert up.shape == (FULL[0] * FULL[1], 300)
     assert np.allclose(up[:, 200], alone.ravel())
+    # Area averaging: all columns in one call at an integer ratio, 4 at a time otherwise.
+    for small in (HALF, (20, 27, 1)):
+        down = resample_columns(up, FULL, small, cv2.INTER_AREA)
+        alone = cv2.resize(up[:, 200].reshape(FULL[:2]), (small[1], small[0]),
+                           interpolation=cv2.INTER_AREA)
+        assert down.shape == (small[0] * small[1], 300)
+        assert np.allclose(down[:, 200], alone.ravel(), atol=1e-6)
 
 
 def test_pixel_sample_picks_one_full_size_pixel_per_solved_one():
