@@ -12,6 +12,10 @@ solve's temporal factors (:func:`carry_backgrounds`): the solve fixes how the
 background changes over the window (its right singular vectors, the frames'
 mixing of a few background images), and each full-size pixel's own time series
 fixes its share of each, wherever the solve did not call that pixel foreground.
+The carried background stays in factored form (:class:`CarriedBackground`),
+and the window's noise levels are read at one full-size pixel per solved one
+(:class:`PixelSample`): what follows the capped solve then costs a fraction
+of the solve, where at full size it had cost more than the solve itself.
 """
 
 import cv2
