@@ -68,20 +68,24 @@ def observed_median(magnitude, observed=None):
     return ordered[np.arange(ordered.shape[0]), np.maximum(count - 1, 0) // 2], count
 
 
-def pixel_noise(residual, shape, observed=None, uniform=False):
+def pixel_noise(residual, shape, observed=None, uniform=False, sample=None):
     """
     Return each pixel's noise level ``sigma_p`` (n,) float32 from a window's residual.
 
     Parameters
     ----------
     residual : ndarray (C, n, m)
-        ``D - L`` of the window.
+        ``D - L`` of the window; with ``sample``, of its sampled pixels only (C, k, m).
     shape : tuple (rows, cols, C)
         Processing shape.
     observed : ndarray (n, m) bool or None
-        Entries that hold the frame's own pixel; None: all.
+        Entries that hold the frame's own pixel (with ``sample``: (k, m)); None: all.
     uniform : bool
         Give every pixel the typical level (the ablation of the per-pixel rule).
+    sample : PixelSample or None
+        The levels are read at ``sample``'s pixels, a coarser grid of the
+        frame (:class:`~dgmod_ros.core.streaming.solve_resolution.PixelSample`),
+        and upsampled to ``shape`` before the smoothing; None: at every pixel.
 
     """
     rows, cols = shape[:2]
@@ -94,6 +98,10 @@ def pixel_noise(residual, shape, observed=None, uniform=False):
     if uniform:
         return np.full(rows * cols, typical, dtype=np.float32)
     sigma = np.where(seen, np.maximum(sigma, typical), typical).astype(np.float32)
+    if sample is not None:
+        # Upsampled unsmoothed, so that the smoothing below spans the same
+        # neighbourhood of the frame as at every pixel.
+        sigma = sample.upsample(sigma)
     smooth = cv2.blur(sigma.reshape(rows, cols), (_NOISE_SMOOTHING, _NOISE_SMOOTHING))
     return smooth.ravel()
 

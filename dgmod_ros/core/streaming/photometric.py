@@ -66,29 +66,32 @@ def distortion(frame, background):
     return alpha, np.sqrt(np.einsum('c...,c...->...', across, across))
 
 
-def chroma_noise(data, residual, shape, observed=None, uniform=False):
+def chroma_noise(data, residual, shape, observed=None, uniform=False, sample=None):
     """
     Return each pixel's chromaticity noise level (n,) float32 from a window solve.
 
     Parameters
     ----------
     data : ndarray (C, n, m)
-        The window ``D``.
+        The window ``D``; with ``sample``, its sampled pixels only (C, k, m).
     residual : ndarray (C, n, m)
-        ``D - L``.
+        ``D - L``, at the same pixels as ``data``.
     shape : tuple (rows, cols, C)
         Processing shape.
     observed : ndarray (n, m) bool or None
-        Entries that hold the frame's own pixel; None: all.
+        Entries that hold the frame's own pixel (with ``sample``: (k, m)); None: all.
     uniform : bool
         Give every pixel the typical level.
+    sample : PixelSample or None
+        Read the levels at ``sample``'s pixels and upsample them
+        (:func:`~dgmod_ros.core.streaming.foreground.pixel_noise`); None: every pixel.
 
     """
     from .lighting_kernel import window_chroma     # numba: loaded on first use
     chroma = window_chroma(data, residual)
     if chroma is None:
         _, chroma = distortion(data, data - residual)
-    return pixel_noise(chroma[None], shape, observed, uniform)
+    return pixel_noise(chroma[None], shape, observed, uniform, sample)
 
 
 class LightingTest:

@@ -12,17 +12,23 @@ solve's temporal factors (:func:`carry_backgrounds`): the solve fixes how the
 background changes over the window (its right singular vectors, the frames'
 mixing of a few background images), and each full-size pixel's own time series
 fixes its share of each, wherever the solve did not call that pixel foreground.
+The carried background stays in factored form (:class:`CarriedBackground`),
+and the window's noise levels are read at one full-size pixel per solved one
+(:class:`PixelSample`): what follows the capped solve then costs a fraction
+of the solve, where at full size it had cost more than the solve itself.
 """
 
 import cv2
 import numpy as np
 
+from .fast_path import background_basis
 from .foreground import pixel_noise
 from ..linalg import thin_svd
 
 # Most channels one cv2.resize call takes: OpenCV 5's CV_CN_MAX, and 4 for
-# area averaging at a ratio that is not an integer.
-_RESIZE_CHANNELS = {cv2.INTER_AREA: 4}
+# area averaging at a ratio that is not an integer (an integer one takes all:
+# one call of 30 channels cost a fifth of eight calls of 4 and their copies).
+_AREA_CHANNELS = 4
 _MAX_CHANNELS = 128
 # Noise levels of the solve's residual above which an entry is held out of the
 # full-size fit (a short solve's S holds much of the noise too, so S's own
@@ -63,7 +69,9 @@ def resample_columns(columns, shape, new_shape, interpolation):
     width = columns.shape[1]
     image = columns.reshape(rows, cols, width)
     out = np.empty((new_rows, new_cols, width), dtype=columns.dtype)
-    group = _RESIZE_CHANNELS.get(interpolation, _MAX_CHANNELS)
+    integer = rows % new_rows == 0 and cols % new_cols == 0
+    group = (_AREA_CHANNELS if interpolation == cv2.INTER_AREA and not integer
+             else _MAX_CHANNELS)
     for start in range(0, width, group):
         part = np.ascontiguousarray(image[:, :, start:start + group])
         resized = cv2.resize(part, (new_cols, new_rows), interpolation=interpolation)
@@ -77,9 +85,123 @@ def downsample_window(data, shape, small_shape):
                      for channel in data])
 
 
+class PixelSample:
+    """
+    One full-size pixel for each pixel of the solve's grid: where a carried window's noise is read.
+
+    A noise level is a median over the window's columns at each pixel, as
+    costly at 640 x 480 as the solve itself once that is capped. Read at the
+    full-size pixel nearest each solve-size pixel's centre (a picked pixel,
+    not an area average, whose noise would be lower by the averaging), the
+    levels are those of full-size pixels, upsampled bilinearly; they are
+    smoothed over 5 x 5 pixels afterwards anyway
+    (:func:`~dgmod_ros.core.streaming.foreground.pixel_noise`).
+
+    Parameters
+    ----------
+    shape, small_shape : tuple (rows, cols, ...)
+        Full and solve frame sizes.
+
+    Attributes
+    ----------
+    pixels : ndarray (k,) intp
+        Row-major full-size indices of the picked pixels, in the solve grid's order.
+
+    """
+
+    def __init__(self, shape, small_shape):
+        self.shape, self.small_shape = tuple(shape[:2]), tuple(small_shape[:2])
+        (rows, cols), (small_rows, small_cols) = self.shape, self.small_shape
+        picked_rows = ((np.arange(small_rows) + 0.5) * (rows / small_rows)).astype(np.intp)
+        picked_cols = ((np.arange(small_cols) + 0.5) * (cols / small_cols)).astype(np.intp)
+        self.pixels = (np.minimum(picked_rows, rows - 1)[:, None] * cols
+                       + np.minimum(picked_cols, cols - 1)[None, :]).ravel()
+
+    def take(self, array):
+        """Return ``array``'s picked pixels: its second-to-last axis, (n, m) or (C, n, m)."""
+        return np.take(array, self.pixels, axis=-2)
+
+    def upsample(self, levels):
+        """Return (n,) float32 levels bilinearly upsampled from one per picked pixel (k,)."""
+        small = np.asarray(levels, dtype=np.float32).reshape(self.small_shape)
+        return cv2.resize(small, self.shape[::-1], interpolation=cv2.INTER_LINEAR).ravel()
+
+
+def solve_spd(gram, rhs):
+    """
+    Return ``x`` (r, k) of the k symmetric positive definite r x r systems ``gram x = rhs``.
+
+    ``gram`` is (r, r, k) and ``rhs`` (r, k): each system one column, so the
+    elimination (no pivoting, which a positive definite matrix does not
+    need) runs over contiguous rows of k, with loops over r only.
+    ``np.linalg.solve`` on (k, r, r) pays a per-matrix overhead that cost
+    more than the arithmetic of 2 x 2 systems at 640 x 480.
+    """
+    upper = np.array(gram, dtype=np.float32)
+    x = np.array(rhs, dtype=np.float32)
+    r = x.shape[0]
+    for i in range(r):
+        for j in range(i + 1, r):
+            factor = upper[j, i] / upper[i, i]
+            upper[j, i:] -= factor * upper[i, i:]
+            x[j] -= factor * x[i]
+    for i in reversed(range(r)):
+        x[i] -= np.einsum('jk,jk->k', upper[i, i + 1:], x[i + 1:])
+        x[i] /= upper[i, i]
+    return x
+
+
+class CarriedBackground:
+    """
+    The full-size backgrounds of a carried window solve, as factors ``L_c = A_c V_c^T``.
+
+    ``L_c`` itself (n x m a channel) is formed only where a caller needs all
+    of it (:meth:`residuals` without pixels): the newest and mean columns,
+    the fast path's basis and the residual at a sample of pixels come from
+    the factors.
+
+    Parameters
+    ----------
+    factors : list of (ndarray (n, r) float32, ndarray (m, r) float32)
+        Each channel's ``A`` and orthonormal ``V``.
+
+    """
+
+    def __init__(self, factors):
+        self.factors = factors
+
+    def bases(self, rank):
+        """
+        Return each channel's fast-path basis (n, r'): the left singular vectors of ``L``.
+
+        With ``V`` orthonormal, ``A = U S W^T`` gives ``L = U S (V W)^T``: the
+        SVD of ``A`` (n x r) is that of ``L`` (n x m), at r / m of the cost.
+        """
+        return [background_basis(coef, rank) for coef, _ in self.factors]
+
+    def newest(self):
+        """Return the newest column of each channel's background (n, C)."""
+        return np.stack([coef @ temporal[-1] for coef, temporal in self.factors], axis=1)
+
+    def mean(self):
+        """Return each channel's mean background column (n, C)."""
+        return np.stack([coef @ temporal.mean(axis=0) for coef, temporal in self.factors],
+                        axis=1)
+
+    def residuals(self, data, pixels=None):
+        """Return ``D - L`` (C, n, m), or at ``pixels`` only (C, k, m) with ``data`` full-size."""
+        if pixels is not None:
+            data = np.take(data, pixels, axis=-2)
+        out = np.empty_like(data)
+        for channel, (coef, temporal) in enumerate(self.factors):
+            coef = coef if pixels is None else coef[pixels]
+            np.subtract(data[channel], coef @ temporal.T, out=out[channel])
+        return out
+
+
 def carry_backgrounds(data, shape, backgrounds, small_residuals, small_shape, rank):
     """
-    Return the full-size backgrounds of a window solved at ``small_shape``, and ``D - L``.
+    Return the full-size backgrounds of a window solved at ``small_shape``.
 
     Each channel's full-size background is ``A V^T``: ``V`` (m x r,
     orthonormal) the solve's leading ``rank`` temporal factors, and each
@@ -92,9 +214,15 @@ def carry_backgrounds(data, shape, backgrounds, small_residuals, small_shape, ra
     detail ``D - P V^T``, and zero detail counts as a tenth of an observed
     frame (a ridge of ``0.1/m``: it shrinks a fully observed pixel's detail
     by 0.3% at m = 30, and keeps the system of a pixel seen in fewer than r
-    frames solvable, that pixel keeping the solve's background). A pixel with
-    every entry in has ``V^T V = I`` for its r x r matrix, so its fit is
-    ``D V - P``; only the others solve theirs (batched).
+    frames solvable, that pixel keeping the solve's background).
+
+    With ``W`` the weights and ``G = V^T diag(w) V`` a pixel's r x r matrix,
+    that fit ``A = P + (G + rho I)^-1 (W o (D - P V^T)) V`` is
+    ``A = (G + rho I)^-1 ((W o D) V + rho P)``: no n x m detail is formed, and
+    every pixel solves its system (batched, :func:`solve_spd`), those with
+    every entry in (``G = I``) as well, which costs less than gathering the
+    others (most pixels have one entry out: 3-sigma exceedances over m
+    columns, widened by the upsampling).
 
     Parameters
     ----------
@@ -111,30 +239,27 @@ def carry_backgrounds(data, shape, backgrounds, small_residuals, small_shape, ra
 
     Returns
     -------
-    backgrounds : list of ndarray (n, m) float32
-    residuals : ndarray (C, n, m) float32
+    CarriedBackground
 
     """
     magnitude = np.abs(small_residuals).max(axis=0)                       # (n_small, m)
     noise = pixel_noise(small_residuals, small_shape)
     held_out = (magnitude > _HELD_OUT_SIGMAS * noise[:, None]).astype(np.float32)
     held_out = resample_columns(held_out, small_shape, shape, cv2.INTER_LINEAR)
-    partial = np.flatnonzero(held_out.max(axis=1) > 0)      # pixels with an entry out
-    weights = (held_out[partial] == 0).astype(np.float32)    # (k, m)
-    ridge = 0.1 / data.shape[2]
-    full = []
-    residuals = np.empty_like(data)
+    weights = (held_out == 0).astype(np.float32)                          # (n, m)
+    ridge = np.float32(0.1 / data.shape[2])
+    factors = []
     for channel, small in enumerate(backgrounds):
         _, _, temporal = thin_svd(small, int(rank))                       # (m, r)
         r = temporal.shape[1]
         start = resample_columns(small @ temporal, small_shape, shape, cv2.INTER_LINEAR)
-        coef = (data[channel] @ temporal - start) / np.float32(1.0 + ridge)
-        if partial.size:
-            detail = (data[channel][partial] - start[partial] @ temporal.T) * weights
-            outer = (temporal[:, :, None] * temporal[:, None, :]).reshape(-1, r * r)
-            gram = (weights @ outer).reshape(-1, r, r) + ridge * np.eye(r, dtype=np.float32)
-            coef[partial] = np.linalg.solve(gram, (detail @ temporal)[:, :, None])[:, :, 0]
-        background = (start + coef) @ temporal.T
-        np.subtract(data[channel], background, out=residuals[channel])
-        full.append(background)
-    return full, residuals
+        outer = (temporal[:, :, None] * temporal[:, None, :]).reshape(-1, r * r)
+        # Systems as columns (r, r, n) and (r, n): the elimination's rows are
+        # contiguous (the products as (n, m) @ (m, .), then transposed, cost
+        # a third of the transposed products).
+        gram = np.ascontiguousarray((weights @ outer).T).reshape(r, r, -1)
+        gram[np.arange(r), np.arange(r)] += ridge
+        rhs = ((weights * data[channel]) @ temporal).T + ridge * start.T
+        coef = np.ascontiguousarray(solve_spd(gram, rhs).T)               # (n, r)
+        factors.append((coef, temporal))
+    return CarriedBackground(factors)

@@ -10,7 +10,7 @@ from .fast_path import background_basis, projection_residual
 from .foreground import pixel_noise
 from .photometric import chroma_noise
 from .results import BackgroundModel, SolverFailure
-from .solve_resolution import carry_backgrounds, downsample_window
+from .solve_resolution import carry_backgrounds, downsample_window, PixelSample
 from ..separation import separate_channels
 
 
@@ -43,25 +43,29 @@ def warm_starts(snapshot):
     return [state.shifted(shift) for state in previous.states]
 
 
-def window_noise(snapshot, residuals, basis):
+def window_noise(snapshot, residuals, basis, sample=None):
     """
     Return each pixel's noise level from the residual ``snapshot.noise_source`` names.
 
     'solve': the solve's ``D - L``; 'projection' / 'least_squares': each
     column against its robust / least-squares projection on the fast path's
     basis (the statistic the per-frame decision thresholds); 'max': the
-    larger of the 'solve' and 'projection' levels.
+    larger of the 'solve' and 'projection' levels. With a
+    :class:`~.solve_resolution.PixelSample`, the levels are read at its
+    pixels (``residuals`` holds those only) and upsampled.
     """
     uniform = snapshot.decision == 'uniform'
     source = snapshot.noise_source
+    take = (lambda array: array) if sample is None else sample.take
+    observed = None if snapshot.observed is None else take(snapshot.observed)
 
     def level(residual):
-        return pixel_noise(residual, snapshot.shape, snapshot.observed, uniform=uniform)
+        return pixel_noise(residual, snapshot.shape, observed, uniform=uniform, sample=sample)
 
     if source == 'solve':
         return level(residuals)
-    projected = level(projection_residual(basis, snapshot.data,
-                                          robust=source != 'least_squares'))
+    projected = level(take(projection_residual(basis, snapshot.data,
+                                               robust=source != 'least_squares')))
     return np.maximum(projected, level(residuals)) if source == 'max' else projected
 
 
@@ -74,8 +78,10 @@ def solve_window(snapshot):
     (:mod:`~dgmod_ros.core.streaming.solve_resolution`); with
     ``refit_background`` the background is that fit at any solve size (each
     pixel's own series on the solve's leading temporal factors, the entries
-    the solve called foreground held out). The rest (basis, noise levels) is
-    computed at the frames' size either way.
+    the solve called foreground held out). The basis is computed at the
+    frames' size either way; the noise levels of a downscaled solve are read
+    at one full-size pixel per solved one and upsampled
+    (:class:`~.solve_resolution.PixelSample`).
 
     Raises
     ------
@@ -86,6 +92,7 @@ def solve_window(snapshot):
     rows, cols, channels = snapshot.shape
     small_shape = _solved_shape(snapshot)
     downscaled = small_shape != tuple(snapshot.shape)
+    carried = downscaled or snapshot.refit_background
     started = time.perf_counter()
     data = (downsample_window(snapshot.data, snapshot.shape, small_shape) if downscaled
             else snapshot.data)
@@ -97,30 +104,42 @@ def solve_window(snapshot):
     backgrounds, residuals = separated.backgrounds, separated.residuals
     if separated.diverged or not all(np.all(np.isfinite(b)) for b in backgrounds):
         raise SolverFailure('window solve produced non-finite values')
-    if downscaled or snapshot.refit_background:
-        backgrounds, residuals = carry_backgrounds(
-            snapshot.data, snapshot.shape, backgrounds, residuals, small_shape,
-            snapshot.basis_rank)
-    bases = [background_basis(b, int(snapshot.basis_rank)) for b in backgrounds]
+    rank = int(snapshot.basis_rank)
+    if carried:
+        # Factors only: the full-size backgrounds are never formed whole.
+        carry = carry_backgrounds(snapshot.data, snapshot.shape, backgrounds, residuals,
+                                  small_shape, rank)
+        bases, newest, mean = carry.bases(rank), carry.newest(), carry.mean()
+    else:
+        bases = [background_basis(b, rank) for b in backgrounds]
+        newest = np.stack([b[:, -1] for b in backgrounds], axis=1)
+        mean = np.stack([b.mean(axis=1) for b in backgrounds], axis=1)
     basis = np.zeros((channels, rows * cols, max(b.shape[1] for b in bases)), dtype=np.float32)
     for channel, channel_basis in enumerate(bases):
         basis[channel, :, :channel_basis.shape[1]] = channel_basis
-    noise = chroma = None
+    noise = chroma = threshold = None
     if snapshot.decision != 'global':
-        noise = window_noise(snapshot, residuals, basis)
+        # A carried solve reads its levels at one full-size pixel per solved
+        # one, and needs its residual there only.
+        sample = PixelSample(snapshot.shape, small_shape) if downscaled else None
+        if carried:
+            residuals = carry.residuals(snapshot.data,
+                                        None if sample is None else sample.pixels)
+        take = (lambda array: array) if sample is None else sample.take
+        noise = window_noise(snapshot, residuals, basis, sample)
         if channels == 3:
-            chroma = chroma_noise(snapshot.data, residuals, snapshot.shape,
-                                  snapshot.observed, snapshot.decision == 'uniform')
-    return BackgroundModel(
-        basis=basis,
-        background=np.stack([b[:, -1] for b in backgrounds], axis=1).reshape(
-            rows, cols, channels),
-        mean_background=np.stack([b.mean(axis=1) for b in backgrounds], axis=1).reshape(
-            rows, cols, channels),
+            observed = None if snapshot.observed is None else take(snapshot.observed)
+            chroma = chroma_noise(take(snapshot.data), residuals, snapshot.shape,
+                                  observed, snapshot.decision == 'uniform', sample)
+    else:
         # The global rule's threshold costs a median over the whole window; the
         # per-pixel decisions read ``noise`` instead.
-        threshold=(snapshot.mask_rule.estimate_threshold(residuals, snapshot.data)
-                   if snapshot.decision == 'global' else None),
+        if carried:
+            residuals = carry.residuals(snapshot.data)
+        threshold = snapshot.mask_rule.estimate_threshold(residuals, snapshot.data)
+    return BackgroundModel(
+        basis=basis, background=newest.reshape(rows, cols, channels),
+        mean_background=mean.reshape(rows, cols, channels), threshold=threshold,
         shape=snapshot.shape, first_id=snapshot.first_id, last_id=snapshot.last_id,
         states=separated.states, seconds=time.perf_counter() - started,
         iterations=separated.iterations, info=separated.info, ticket=snapshot.ticket,
