@@ -231,3 +231,20 @@ def test_detector_solves_capped_and_warm_starts_at_the_solve_size(frames):
     # The default solve scale halves the processing size whatever the cap.
     detector.configure(solve_scale=0.5)
     assert detector.snapshot().solve_shape == (24, 32, 3)
+
+
+def test_a_snapshot_holds_its_window_while_frames_go_on(frames):
+    # The snapshot hands the solve the buffered columns, stacked in the solve's
+    # thread: frames admitted after it (conditionally, the oldest dropped)
+    # must not reach its window.
+    values = dict(config.DEFAULTS, window=8, stride=3, min_frames=3, memory_spacing=1)
+    detector = config.build_detector(config.validate(values))
+    for frame in frames[:12]:
+        detector.process(frame)
+    snapshot = detector.snapshot()
+    expected = np.stack(detector.buffer_.columns(), axis=2).copy()
+    for frame in frames[12:30]:
+        detector.push(frame)
+    assert not isinstance(snapshot.data, np.ndarray)
+    assert np.array_equal(snapshot.window(), expected)
+    assert snapshot.window() is snapshot.data and snapshot.data.shape[2] == 8

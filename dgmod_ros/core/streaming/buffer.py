@@ -54,6 +54,10 @@ class FrameWindow:
         pair = np.stack([self._frames[-1].ravel(), columns.ravel()], axis=1)
         return moving_frames(pair, threshold).size != 2
 
+    def columns(self):
+        """Return the buffered frames (C, n) oldest first, as a tuple (they are never written)."""
+        return tuple(self._frames)
+
     def stack(self, extra=None):
         """Return the buffered frames as (C, n, m); ``extra`` (C, n) alone when empty."""
         if not self._frames:

@@ -520,7 +520,8 @@ class SlidingWindowDetector(StreamingDetector):
         self._ensure_started()
         if len(self.buffer_) < 2:
             raise ValueError('a window solve needs at least 2 buffered frames')
-        data = self.buffer_.stack()                            # (C, n, m)
+        # Stacked in the solve's thread (WindowSnapshot.window), not in this one.
+        data = self.buffer_.columns()
         # An early start restarts the count at the frame the solve is due;
         # if it is discarded, the frames it took back are given back.
         self.early_credit_ = self.since_solve_ + int(ahead) if ahead else 0

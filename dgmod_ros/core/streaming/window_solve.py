@@ -90,6 +90,7 @@ def solve_window(snapshot):
 
     """
     rows, cols, channels = snapshot.shape
+    snapshot.window()
     small_shape = _solved_shape(snapshot)
     downscaled = small_shape != tuple(snapshot.shape)
     carried = downscaled or snapshot.refit_background
