@@ -108,10 +108,10 @@ PARAMETERS = (
               '(<= stride): the solve runs beside that many frames of per-frame work, and the '
               'masks do not depend on its speed (sync mode and offline; async installs late '
               'solves at the first frame after they end)', 0, 300),
-    Parameter('solve_pixels', 76800, 'largest frame (pixels) the window solve runs at: a '
-              'larger processing size is solved scaled down to this, same aspect, and its '
-              "full-size background carried from the solve's temporal factors (76800 = 320 x "
-              '240, a 640 x 480 camera at scale 0.5)', 64, 100000000),
+    Parameter('solve_pixels', 19200, 'largest frame (pixels) the window solve runs at: a '
+              'larger one (after solve_scale) is solved scaled down to this, same aspect, and '
+              "its full-size background fit from the solve's temporal factors (19200 = 160 x "
+              '120, a 640 x 480 camera at the default scale and solve_scale)', 64, 100000000),
     Parameter('solve_scale', 0.5, 'scale of the window solve against the processing size '
               '(before the solve_pixels cap); the full-size background is fit from the '
               "solve's temporal factors", 0.05, 1.0),

@@ -173,13 +173,14 @@ class SlidingWindowDetector(StreamingDetector):
         beside ``solve_lag`` frames of per-frame work with the same masks
         whatever its speed (the install rule of
         :class:`~dgmod_ros.core.streaming.contract.StreamingDetector`).
-    solve_pixels : int, default=76800
-        Largest frame (pixels) the window solve runs at. A larger processing
-        size is solved scaled down to at most this many pixels, same aspect,
-        and the full-size background carried from the solve's temporal
-        factors (:mod:`~dgmod_ros.core.streaming.solve_resolution`); the
-        default is 320 x 240, the processing size of a 640 x 480 camera at
-        the default ``scale``.
+    solve_pixels : int, default=19200
+        Largest frame (pixels) the window solve runs at. A larger solve
+        (after ``solve_scale``) is scaled down to at most this many pixels,
+        same aspect, and the full-size background carried from the solve's
+        temporal factors (:mod:`~dgmod_ros.core.streaming.solve_resolution`);
+        the default is 160 x 120, the solve of a 640 x 480 camera at the
+        default ``scale`` and ``solve_scale``, so that larger cameras and
+        ``scale`` 1 cost about the same solve.
     solve_scale : float, default=0.5
         Scale in (0, 1] of the window solve against the processing size
         (before the ``solve_pixels`` cap): the solve fixes the background's
@@ -218,7 +219,7 @@ class SlidingWindowDetector(StreamingDetector):
                  noise_source='solve', pixel_k=6.0, median_size=5, ghost_test=True,
                  still_frames=25, mrf_beta=2.0, chroma_cue=True, texture_cue=True,
                  texture_bits=8, moving_texture_k=3.0, moving_texture_bits=16, solve_lag=0,
-                 solve_pixels=76800, solve_scale=0.5, refit_background=True):
+                 solve_pixels=19200, solve_scale=0.5, refit_background=True):
         self.model = model
         self.window = window
         self.stride = stride
