@@ -90,7 +90,7 @@ def solve_window(snapshot):
 
     """
     rows, cols, channels = snapshot.shape
-    snapshot.window()
+    snapshot.window()           # the columns stacked here, in the solve's thread
     small_shape = _solved_shape(snapshot)
     downscaled = small_shape != tuple(snapshot.shape)
     carried = downscaled or snapshot.refit_background
@@ -120,8 +120,8 @@ def solve_window(snapshot):
         basis[channel, :, :channel_basis.shape[1]] = channel_basis
     noise = chroma = threshold = None
     if snapshot.decision != 'global':
-        # A carried solve reads its levels at one full-size pixel per solved
-        # one, and needs its residual there only.
+        # A downscaled solve reads its levels at one full-size pixel per
+        # solved one, and needs its residual there only.
         sample = PixelSample(snapshot.shape, small_shape) if downscaled else None
         if carried:
             residuals = carry.residuals(snapshot.data,
