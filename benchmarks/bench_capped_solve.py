@@ -4,7 +4,8 @@
 Cost of one window solve of a 640 x 480 camera: the defaults, ``scale:=1.0`` capped and uncapped.
 
 Builds each case's window from the same synthetic 640 x 480 colour scene at
-its processing size (the defaults: 320 x 240, solved as they are;
+its processing size (the defaults: 320 x 240, solved at 160 x 120 and
+refit; the defaults before 2026-12-01: 320 x 240 solved as it is, no refit;
 ``scale=1.0``: 640 x 480, solved at ``solve_pixels`` and carried back;
 ``scale=1.0`` uncapped: solved at 640 x 480), solves it once cold, then
 times the warm-started solve of the window one frame on, the cases
@@ -32,7 +33,10 @@ import numpy as np
 
 CASES = (('defaults (scale 0.5)', {}),
          ('scale=1.0, capped', {'scale': 1.0}),
-         ('scale=1.0, uncapped', {'scale': 1.0, 'solve_pixels': 640 * 480}))
+         ('defaults before', {'solve_scale': 1.0, 'refit_background': False,
+                              'solve_pixels': 320 * 240}),
+         ('scale=1.0, uncapped', {'scale': 1.0, 'solve_scale': 1.0,
+                                  'solve_pixels': 640 * 480}))
 
 
 def snapshots(values, frames):
@@ -51,7 +55,9 @@ def snapshots(values, frames):
             previous=previous, model=detector.model_, mask_rule=detector.mask_rule_,
             basis_rank=int(detector.basis_rank), decision=detector.decision,
             noise_source=detector.noise_source,
-            solve_shape=solve_shape(shape, int(detector.solve_pixels)))
+            solve_shape=solve_shape(shape, int(detector.solve_pixels),
+                                    float(detector.solve_scale)),
+            refit_background=bool(detector.refit_background))
 
     first = window_solve.solve_window(snapshot(0, None))
     return snapshot(1, first)
