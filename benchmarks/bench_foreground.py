@@ -62,7 +62,8 @@ def main():
     earlier = detector.recent_[0][1]
     weak_k, weak_bits = detector.moving_texture_k, int(detector.moving_texture_bits)
     snapshot = detector.snapshot()
-    residual = snapshot.data - snapshot.data.mean(axis=2, keepdims=True)
+    window = snapshot.window()                  # (C, n, m): the snapshot holds columns
+    residual = window - window.mean(axis=2, keepdims=True)
     age = detector.foreground_age_
     kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (5, 5))
     stages = {
@@ -130,7 +131,7 @@ def main():
     solve = median_ms(lambda: detector.solve(snapshot), max(3, args.repeats // 10))
     noise = median_ms(lambda: pixel_noise(residual, shape, snapshot.observed),
                       max(3, args.repeats // 10))
-    chroma = median_ms(lambda: chroma_noise(snapshot.data, residual, shape, snapshot.observed),
+    chroma = median_ms(lambda: chroma_noise(window, residual, shape, snapshot.observed),
                        max(3, args.repeats // 10))
     print(f'  {"window solve (3 channels, warm start)":45s} {solve:7.1f} ms per solve, '
           f'{solve / stride:6.2f} ms per frame')
@@ -139,7 +140,7 @@ def main():
     print(f'  {"  of which chromaticity noise levels":45s} {chroma:7.1f} ms per solve, '
           f'{chroma / stride:6.2f} ms per frame')
     for robust, name in ((True, 'IRLS'), (False, 'least-squares')):
-        projected = median_ms(lambda: projection_residual(model.basis, snapshot.data, robust),
+        projected = median_ms(lambda: projection_residual(model.basis, window, robust),
                               max(3, args.repeats // 10))
         print(f'  {"  noise_source residual, " + name + " projection":45s} {projected:7.1f} '
               f'ms per solve, {projected / stride:6.2f} ms per frame')

@@ -2,7 +2,7 @@
 # Licensed under the Apache License, Version 2.0
 """The fast path's compiled l1 projection against its numpy formulation."""
 
-from dgmod_ros.core.streaming.fast_path import (background_basis, robust_projection,
+from dgmod_ros.core.streaming.fast_path import (background_basis, fit_step, robust_projection,
                                                 robust_projection_reference)
 import numpy as np
 import pytest
@@ -44,3 +44,23 @@ def test_projection_with_a_zero_padded_channel_basis():
     basis[1, :, 1] = 0.0
     assert np.allclose(robust_projection(basis, frame),
                        robust_projection_reference(basis, frame), atol=1e-5)
+
+
+@pytest.mark.parametrize('rank', [1, 2, 3])
+def test_sampled_fit_equals_numpy(rank):
+    # 3000 pixels, at most 700 weighed: every 4th pixel.
+    basis, frame, _ = _frame_and_basis(rank)
+    assert np.allclose(robust_projection(basis, frame, fit_pixels=700),
+                       robust_projection_reference(basis, frame, fit_pixels=700), atol=1e-5)
+
+
+def test_sampled_fit_projects_every_pixel_as_the_full_fit_does():
+    basis, frame, _ = _frame_and_basis(2, n=12000)
+    frame[:, 4000:5200] = 0.95          # the person scaled with the frame
+    full = robust_projection(basis, frame, fit_pixels=12000)
+    sampled = robust_projection(basis, frame, fit_pixels=1000)     # every 12th pixel
+    assert fit_step(12000, 1000) == 12 and fit_step(12000, 12000) == 1
+    # Measured: at most 0.0026 apart (the frame's noise is 0.01), against the
+    # person's 0.4 and more.
+    assert np.abs(sampled - full).max() < 0.005
+    assert np.abs(sampled[:, 4000:5200] - 0.95).min() > 0.2
