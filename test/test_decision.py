@@ -209,8 +209,9 @@ def _window_on_a_basis(seed=1, pixels=400, frames=6):
     return basis.astype(np.float32), data.astype(np.float32)
 
 
-def test_projection_residual_is_each_column_minus_its_robust_projection():
-    basis, data = _window_on_a_basis()
+@pytest.mark.parametrize('pixels', [400, 45000])      # 45000: the sweeps weigh every 2nd pixel
+def test_projection_residual_is_each_column_minus_its_robust_projection(pixels):
+    basis, data = _window_on_a_basis(pixels=pixels)
     residual = projection_residual(basis, data)
     for column in range(data.shape[2]):
         expected = data[..., column] - robust_projection(basis, data[..., column])

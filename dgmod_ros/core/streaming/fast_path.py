@@ -22,7 +22,7 @@ _IRLS_FLOOR = 1e-3
 _BASIS_RTOL = 1e-3
 # Most pixels the IRLS sweeps weigh: the fit has basis_rank unknowns a
 # channel, which a regular sample of the frame's pixels fixes as well as all
-# of them (docs/results.md has the measured effect); the projection itself is
+# of them (docs/node.md has the measured effect); the projection itself is
 # of every pixel. 160 x 120, a 640 x 480 camera's frame at scale 0.25.
 FIT_PIXELS = 19200
 
@@ -113,17 +113,20 @@ def projection_residual(basis, data, robust=True):
 
     """
     residual = np.empty_like(data)
+    step = fit_step(data.shape[1])          # the sweeps' pixel sample, as robust_projection's
     for channel in range(data.shape[0]):
         used = np.any(basis[channel] != 0, axis=0)
         b, d = basis[channel][:, used], data[channel]                # (n, r), (n, m)
         coef = b.T @ d                                                # (r, m)
         if robust:
             rank = b.shape[1]
-            products = (b[:, :, None] * b[:, None, :]).reshape(b.shape[0], rank * rank)
+            b_fit, d_fit = b[::step], d[::step]
+            products = (b_fit[:, :, None] * b_fit[:, None, :]).reshape(b_fit.shape[0],
+                                                                       rank * rank)
             for _ in range(_IRLS_SWEEPS):
-                weights = 1.0 / np.maximum(np.abs(d - b @ coef), _IRLS_FLOOR)
+                weights = 1.0 / np.maximum(np.abs(d_fit - b_fit @ coef), _IRLS_FLOOR)
                 gram = (products.T @ weights).T.reshape(-1, rank, rank)      # (m, r, r)
-                right = (b.T @ (weights * d)).T[..., None]                  # (m, r, 1)
+                right = (b_fit.T @ (weights * d_fit)).T[..., None]          # (m, r, 1)
                 coef = np.linalg.solve(gram, right)[..., 0].T
         residual[channel] = d - b @ coef
     return residual
