@@ -12,10 +12,15 @@ from ..masks import MaskRule
 NOISE_SOURCES = ('solve', 'projection', 'least_squares', 'max')
 
 
+def _require_scale(name, value):
+    """Raise ``ValueError`` unless ``value`` is a number in (0, 1]."""
+    if not (isinstance(value, (int, float)) and 0 < value <= 1):
+        raise ValueError(f'{name} must be in (0, 1], got {value!r}')
+
+
 def check_scale_and_color(scale, color):
     """Raise ``ValueError`` for a processing scale outside (0, 1] or an unknown colour mode."""
-    if not (isinstance(scale, (int, float)) and 0 < scale <= 1):
-        raise ValueError(f'scale must be in (0, 1], got {scale!r}')
+    _require_scale('scale', scale)
     if color not in ('gray', 'rgb'):
         raise ValueError(f"color must be 'gray' or 'rgb', got {color!r}")
 
@@ -68,8 +73,7 @@ def check_window_parameters(detector):
     _require_integer('moving_texture_bits', detector.moving_texture_bits, 0, 48)
     _require_integer('solve_lag', detector.solve_lag, 0, stride, f'stride={stride}')
     _require_integer('solve_pixels', detector.solve_pixels, 1)
-    if not (isinstance(detector.solve_scale, (int, float)) and 0 < detector.solve_scale <= 1):
-        raise ValueError(f'solve_scale must be in (0, 1], got {detector.solve_scale!r}')
+    _require_scale('solve_scale', detector.solve_scale)
     (detector.mask_rule or MaskRule()).validate()
 
 

@@ -43,6 +43,11 @@ def warm_starts(snapshot):
     return [state.shifted(shift) for state in previous.states]
 
 
+def _sampled(sample, array):
+    """Return ``array`` (..., n, m) at ``sample``'s pixels; as it is without a sample or array."""
+    return array if sample is None or array is None else sample.take(array)
+
+
 def window_noise(snapshot, residuals, basis, sample=None):
     """
     Return each pixel's noise level from the residual ``snapshot.noise_source`` names.
@@ -56,16 +61,15 @@ def window_noise(snapshot, residuals, basis, sample=None):
     """
     uniform = snapshot.decision == 'uniform'
     source = snapshot.noise_source
-    take = (lambda array: array) if sample is None else sample.take
-    observed = None if snapshot.observed is None else take(snapshot.observed)
+    observed = _sampled(sample, snapshot.observed)
 
     def level(residual):
         return pixel_noise(residual, snapshot.shape, observed, uniform=uniform, sample=sample)
 
     if source == 'solve':
         return level(residuals)
-    projected = level(take(projection_residual(basis, snapshot.data,
-                                               robust=source != 'least_squares')))
+    projected = level(_sampled(sample, projection_residual(
+        basis, snapshot.data, robust=source != 'least_squares')))
     return np.maximum(projected, level(residuals)) if source == 'max' else projected
 
 
@@ -126,12 +130,11 @@ def solve_window(snapshot):
         if carried:
             residuals = carry.residuals(snapshot.data,
                                         None if sample is None else sample.pixels)
-        take = (lambda array: array) if sample is None else sample.take
         noise = window_noise(snapshot, residuals, basis, sample)
         if channels == 3:
-            observed = None if snapshot.observed is None else take(snapshot.observed)
-            chroma = chroma_noise(take(snapshot.data), residuals, snapshot.shape,
-                                  observed, snapshot.decision == 'uniform', sample)
+            chroma = chroma_noise(_sampled(sample, snapshot.data), residuals, snapshot.shape,
+                                  _sampled(sample, snapshot.observed),
+                                  snapshot.decision == 'uniform', sample)
     else:
         # The global rule's threshold costs a median over the whole window; the
         # per-pixel decisions read ``noise`` instead.
