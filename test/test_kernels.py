@@ -9,6 +9,7 @@ from pathlib import Path
 import subprocess
 import sys
 import threading
+import types
 
 from dgmod_ros.core import kernels
 from dgmod_ros.core.dgmod import DualGraphMOD
@@ -171,6 +172,22 @@ def test_openblas_runs_on_one_thread_after_a_fused_solve():
         pytest.skip('no OpenBLAS loaded (another BLAS: nothing to limit)')
     assert set(counts) == {1}
     assert limit_blas_threads(1) == len(counts)
+
+
+def test_blas_libraries_are_read_again_only_after_an_import(monkeypatch):
+    from dgmod_ros.core import runtime
+    limited = limit_blas_threads(1)
+    reads = []
+    real_open = open
+
+    def counting_open(path, *args, **kwargs):
+        reads.append(path)
+        return real_open(path, *args, **kwargs)
+
+    monkeypatch.setattr(runtime, 'open', counting_open, raising=False)
+    assert limit_blas_threads(1) == limited and reads == []
+    monkeypatch.setitem(sys.modules, 'dgmod_test_extension', types.ModuleType('extension'))
+    assert limit_blas_threads(1) == limited and reads == ['/proc/self/maps']
 
 
 def test_threading_layer_survives_numba_imported_first(tmp_path):

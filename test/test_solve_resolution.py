@@ -2,17 +2,21 @@
 # Licensed under the Apache License, Version 2.0
 """The window solve at a capped size and the full-size background carried from it."""
 
+from dataclasses import replace
+
 import cv2
 from dgmod_ros import config
 from dgmod_ros.core.dgmod import DualGraphMOD
 from dgmod_ros.core.masks import MaskRule
+from dgmod_ros.core.streaming.carry_kernel import normal_equations
 from dgmod_ros.core.streaming.fast_path import background_basis
 from dgmod_ros.core.streaming.foreground import pixel_noise
 from dgmod_ros.core.streaming.photometric import chroma_noise
 from dgmod_ros.core.streaming.results import WindowSnapshot
 from dgmod_ros.core.streaming.solve_resolution import (carry_backgrounds, downsample_window,
                                                        PixelSample, resample_columns,
-                                                       solve_shape, solve_spd)
+                                                       resample_frames, solve_shape, solve_spd,
+                                                       take_pixels)
 from dgmod_ros.core.streaming.window_solve import solve_window
 from dgmod_ros.core.synthetic import synthetic_scene
 import numpy as np
@@ -83,6 +87,45 @@ def test_noise_levels_read_at_the_sample_and_upsampled_match_every_pixels():
         assert np.median(error) < 0.03
         assert np.percentile(error, 90) < 0.1
         assert error.max() < 0.25
+
+
+def test_frames_major_windows_resample_and_sample_as_pixel_major_ones():
+    # The snapshot's window is frames-major in memory, a (C, n, m) view of
+    # (m, C, n): the same values as the C-ordered window, read along rows.
+    rng = np.random.default_rng(2)
+    frames = rng.random((30, 3, FULL[0] * FULL[1]), dtype=np.float32)
+    view = frames.transpose(1, 2, 0)
+    plain = np.ascontiguousarray(view)
+    small = downsample_window(view, FULL, HALF)
+    assert small.shape == (3, HALF[0] * HALF[1], 30) and small[0].flags.f_contiguous
+    assert np.array_equal(small, downsample_window(plain, FULL, HALF))
+    assert np.allclose(small[1], resample_columns(plain[1], FULL, HALF, cv2.INTER_AREA),
+                       atol=1e-6)
+    assert np.array_equal(resample_frames(plain[2].T, FULL, HALF, cv2.INTER_AREA), small[2].T)
+    pixels = PixelSample(FULL, HALF).pixels
+    picked = take_pixels(view, pixels)
+    assert picked.flags.c_contiguous and np.array_equal(picked, plain[:, pixels])
+    assert np.array_equal(take_pixels(plain, pixels), picked)
+    assert np.array_equal(take_pixels(plain[0], pixels), plain[0, pixels])
+
+
+@pytest.mark.parametrize('r', [1, 2, 3])
+def test_refit_normal_equations_match_their_definition(r):
+    rng = np.random.default_rng(10 + r)
+    m, n = 17, 2500                                   # more than one block of pixels
+    frames = rng.random((m, 3, n), dtype=np.float32)
+    weights = (rng.random((m, n)) > 0.2).astype(np.float32)
+    temporal = np.linalg.qr(rng.normal(size=(m, r)))[0].astype(np.float32)
+    gram, rhs = normal_equations(frames, 1, weights, temporal)
+    data = frames[:, 1].astype(np.float64)
+    expected_gram = np.einsum('ji,ja,jb->abi', weights, temporal, temporal)
+    expected_rhs = np.einsum('ji,ji,ja->ai', weights, data, temporal)
+    assert gram.shape == (r, r, n) and rhs.shape == (r, n)
+    assert np.allclose(gram, expected_gram, rtol=1e-5, atol=1e-5)
+    assert np.allclose(rhs, expected_rhs, rtol=1e-5, atol=1e-5)
+    # Any memory order of the window gives the same sums.
+    strided = np.asfortranarray(frames)
+    assert np.array_equal(normal_equations(strided, 1, weights, temporal)[1], rhs)
 
 
 @pytest.mark.parametrize('r', [1, 2, 3])
@@ -186,7 +229,7 @@ def test_carried_factors_give_the_backgrounds_columns_and_residuals():
     residuals = carry.residuals(data)
     assert np.allclose(residuals[0], data[0] - background, atol=1e-6)
     pixels = PixelSample(FULL, HALF).pixels
-    assert np.array_equal(carry.residuals(data, pixels), residuals[:, pixels])
+    assert np.array_equal(carry.residuals(data[:, pixels], pixels), residuals[:, pixels])
     # The basis from A (n x r) spans what the SVD of the whole background does.
     basis = carry.bases(2)[0]
     assert np.allclose(basis @ (basis.T @ background), background, atol=1e-4)
@@ -248,3 +291,22 @@ def test_a_snapshot_holds_its_window_while_frames_go_on(frames):
     assert not isinstance(snapshot.data, np.ndarray)
     assert np.array_equal(snapshot.window(), expected)
     assert snapshot.window() is snapshot.data and snapshot.data.shape[2] == 8
+    # Stacked frames-major: each frame's channels are one contiguous block.
+    assert snapshot.frames().flags.c_contiguous and snapshot.frames().shape[0] == 8
+
+
+def test_a_snapshot_of_columns_solves_as_its_stacked_window(frames):
+    # The node hands over columns, stacked frames-major; tests and benchmarks
+    # a C-ordered (C, n, m) window. Both solve to the same model.
+    values = dict(config.DEFAULTS, window=8, stride=3, min_frames=3, memory_spacing=1,
+                  scale=1.0)
+    detector = config.build_detector(config.validate(values))
+    for frame in frames[:14]:
+        detector.process(frame)
+    snapshot = detector.snapshot()
+    assert snapshot.solve_shape != snapshot.shape      # downscaled and refit: the defaults
+    stacked = replace(snapshot, data=np.stack(snapshot.data, axis=2))
+    from_columns, from_stack = solve_window(snapshot), solve_window(stacked)
+    for name in ('basis', 'background', 'mean_background', 'noise', 'chroma_noise'):
+        assert np.allclose(getattr(from_columns, name), getattr(from_stack, name),
+                           atol=1e-5), name

@@ -285,3 +285,5 @@ def compile_all():
     compile_blobs()                                       # the ghost and still tests
     from .streaming.lighting_kernel import compile_kernel as compile_lighting
     compile_lighting()                                    # the lighting test
+    from .streaming.carry_kernel import compile_kernel as compile_carry
+    compile_carry()                                       # the background refit

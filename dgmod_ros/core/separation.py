@@ -70,7 +70,8 @@ def separate_channels(model, data, frame_shape, inits=None):
     started = time.perf_counter()
     inits = inits if inits is not None else [None] * data.shape[0]
     backgrounds, foregrounds, states = [], [], []
-    residuals = np.empty(data.shape, dtype=np.float32)
+    # In the window's own memory order (a frames-major window: F-ordered channels).
+    residuals = np.empty_like(data, dtype=np.float32)
     iterations, info, diverged = 0, 0, False
     for channel, init in enumerate(inits):
         fitted = model.fit(data[channel], frame_shape, init=init)
@@ -78,7 +79,9 @@ def separate_channels(model, data, frame_shape, inits=None):
         backgrounds.append(background)
         foregrounds.append(np.asarray(fitted.foreground_, dtype=np.float32))
         # The fused solver's L is F-ordered; D - L in one memory order.
-        np.subtract(data[channel], c_order(background), out=residuals[channel])
+        if not residuals[channel].flags.f_contiguous:
+            background = c_order(background)
+        np.subtract(data[channel], background, out=residuals[channel])
         states.append(getattr(fitted, 'state_', None))
         iterations = max(iterations, int(getattr(fitted, 'n_iter_', 0)))
         info = max(info, int(getattr(fitted, 'info_', 0)))

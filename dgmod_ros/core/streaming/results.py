@@ -90,7 +90,7 @@ class WindowSnapshot:
     are pushed and parameters change.
     """
 
-    data: object                # (C, n, m) float32, or its columns: see ``window``
+    data: object                # (C, n, m) float32 (any memory order), or its columns: ``window``
     shape: tuple                # (rows, cols, C)
     first_id: int
     last_id: int
@@ -113,11 +113,19 @@ class WindowSnapshot:
         A detector may hand over the buffered columns, a sequence of (C, n)
         arrays that nothing writes to, instead of the stacked window: the
         copy (27 MB at 640 x 480) then runs in the solve's thread, not in
-        the per-frame path that took the snapshot.
+        the per-frame path that took the snapshot. Columns are stacked
+        frames-major, (m, C, n) in memory, and the window is the (C, n, m)
+        view of that: a stack along the new last axis is a strided scatter
+        that took ten times as long (docs/node.md), and the solve reads the
+        window frame by frame (:meth:`frames`) anyway.
         """
         if not isinstance(self.data, np.ndarray):
-            self.data = np.stack(self.data, axis=2)
+            self.data = np.stack(self.data, axis=0).transpose(1, 2, 0)
         return self.data
+
+    def frames(self):
+        """Return the window frame by frame, (m, C, n): the transposed view of :meth:`window`."""
+        return self.window().transpose(2, 0, 1)
 
 
 @dataclass

@@ -21,6 +21,7 @@ of the solve, where at full size it had cost more than the solve itself.
 import cv2
 import numpy as np
 
+from .carry_kernel import normal_equations
 from .fast_path import background_basis
 from .foreground import pixel_noise
 from ..linalg import thin_svd
@@ -79,10 +80,51 @@ def resample_columns(columns, shape, new_shape, interpolation):
     return out.reshape(new_rows * new_cols, width)
 
 
+def resample_frames(frames, shape, new_shape, interpolation):
+    """
+    Return frames-major rows (m, n) resampled from ``shape`` to ``new_shape``, (m, n') float32.
+
+    Each row is one (rows, cols) image, resized by one OpenCV call: the
+    window is frames-major in memory (:meth:`~.results.WindowSnapshot.window`),
+    where a row is contiguous and an image of ``m`` channels is not.
+    """
+    rows, cols = shape[:2]
+    new_rows, new_cols = new_shape[:2]
+    out = np.empty((frames.shape[0], new_rows * new_cols), dtype=np.float32)
+    for row, image in zip(out, frames):
+        image = np.ascontiguousarray(image, dtype=np.float32).reshape(rows, cols)
+        row[:] = cv2.resize(image, (new_cols, new_rows), interpolation=interpolation).ravel()
+    return out
+
+
 def downsample_window(data, shape, small_shape):
-    """Return the window (C, n, m) at ``small_shape`` (area averaging, as frames are scaled)."""
-    return np.stack([resample_columns(channel, shape, small_shape, cv2.INTER_AREA)
-                     for channel in data])
+    """
+    Return the window (C, n, m) at ``small_shape`` (area averaging, as frames are scaled).
+
+    Each channel of the result is F-ordered, an ``n x m`` view of its
+    frames-major ``(m, n)`` rows: what the fused solver works on
+    (:func:`~dgmod_ros.core.kernels.frames_major`), so that it copies nothing.
+    """
+    small = np.stack([resample_frames(channel.T, shape, small_shape, cv2.INTER_AREA)
+                      for channel in data])                                # (C, m, n')
+    return small.transpose(0, 2, 1)
+
+
+def take_pixels(array, pixels):
+    """
+    Return ``array`` (n, m) or (C, n, m) at ``pixels`` of its second-to-last axis, C-ordered.
+
+    A frames-major window (pixels the faster axis in memory,
+    :meth:`~.results.WindowSnapshot.window`) is gathered along its rows and
+    the small result transposed: a gather across its frames' strides cost
+    several times as much.
+    """
+    frames = np.moveaxis(array, -1, 0)                  # (m, ..., n)
+    if array.ndim > 1 and frames.flags.c_contiguous:
+        # np.take of a strided array copies it whole first: take from the rows.
+        picked = np.take(frames.reshape(-1, frames.shape[-1]), pixels, axis=1)
+        return np.ascontiguousarray(np.moveaxis(picked.reshape(frames.shape[:-1] + (-1,)), 0, -1))
+    return np.take(array, pixels, axis=-2)
 
 
 class PixelSample:
@@ -118,8 +160,8 @@ class PixelSample:
                        + np.minimum(picked_cols, cols - 1)[None, :]).ravel()
 
     def take(self, array):
-        """Return ``array``'s picked pixels: its second-to-last axis, (n, m) or (C, n, m)."""
-        return np.take(array, self.pixels, axis=-2)
+        """Return ``array``'s picked pixels (:func:`take_pixels`)."""
+        return take_pixels(array, self.pixels)
 
     def upsample(self, levels):
         """Return (n,) float32 levels bilinearly upsampled from one per picked pixel (k,)."""
@@ -189,10 +231,13 @@ class CarriedBackground:
                         axis=1)
 
     def residuals(self, data, pixels=None):
-        """Return ``D - L`` (C, n, m), or at ``pixels`` only (C, k, m) with ``data`` full-size."""
-        if pixels is not None:
-            data = np.take(data, pixels, axis=-2)
-        out = np.empty_like(data)
+        """
+        Return ``D - L`` (C, n, m), or at ``pixels`` only (C, k, m).
+
+        ``data`` is the window, or with ``pixels`` the window at those pixels
+        (:func:`take_pixels`), which the caller reads for more than this.
+        """
+        out = np.empty(data.shape, dtype=np.float32)
         for channel, (coef, temporal) in enumerate(self.factors):
             coef = coef if pixels is None else coef[pixels]
             np.subtract(data[channel], coef @ temporal.T, out=out[channel])
@@ -227,7 +272,8 @@ def carry_backgrounds(data, shape, backgrounds, small_residuals, small_shape, ra
     Parameters
     ----------
     data : ndarray (C, n, m) float32
-        The window at full size.
+        The window at full size, best frames-major in memory (each
+        ``data[c].T`` with contiguous rows).
     shape, small_shape : tuple (rows, cols, ...)
         Full and solve frame sizes.
     backgrounds : list of ndarray (n_small, m)
@@ -242,24 +288,24 @@ def carry_backgrounds(data, shape, backgrounds, small_residuals, small_shape, ra
     CarriedBackground
 
     """
+    # Frames-major throughout (:meth:`~.results.WindowSnapshot.window`): a
+    # frame's pixels are one contiguous row of ``data[c].T`` and of the weights.
     magnitude = np.abs(small_residuals).max(axis=0)                       # (n_small, m)
     noise = pixel_noise(small_residuals, small_shape)
-    held_out = (magnitude > _HELD_OUT_SIGMAS * noise[:, None]).astype(np.float32)
-    held_out = resample_columns(held_out, small_shape, shape, cv2.INTER_LINEAR)
-    weights = (held_out == 0).astype(np.float32)                          # (n, m)
+    held_out = (magnitude.T > _HELD_OUT_SIGMAS * noise[None, :]).astype(np.float32)
+    held_out = resample_frames(held_out, small_shape, shape, cv2.INTER_LINEAR)
+    weights = (held_out == 0).astype(np.float32)                          # (m, n)
     ridge = np.float32(0.1 / data.shape[2])
+    frames = data.transpose(2, 0, 1)                                      # (m, C, n)
     factors = []
     for channel, small in enumerate(backgrounds):
         _, _, temporal = thin_svd(small, int(rank))                       # (m, r)
         r = temporal.shape[1]
         start = resample_columns(small @ temporal, small_shape, shape, cv2.INTER_LINEAR)
-        outer = (temporal[:, :, None] * temporal[:, None, :]).reshape(-1, r * r)
-        # Systems as columns (r, r, n) and (r, n): the elimination's rows are
-        # contiguous (the products as (n, m) @ (m, .), then transposed, cost
-        # a third of the transposed products).
-        gram = np.ascontiguousarray((weights @ outer).T).reshape(r, r, -1)
+        # Systems as columns (r, r, n) and (r, n): the elimination's rows are contiguous.
+        gram, rhs = normal_equations(frames, channel, weights, temporal)
         gram[np.arange(r), np.arange(r)] += ridge
-        rhs = ((weights * data[channel]) @ temporal).T + ridge * start.T
+        rhs += ridge * start.T
         coef = np.ascontiguousarray(solve_spd(gram, rhs).T)               # (n, r)
         factors.append((coef, temporal))
     return CarriedBackground(factors)

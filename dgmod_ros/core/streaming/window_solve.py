@@ -37,7 +37,7 @@ def warm_starts(snapshot):
         shift = snapshot.first_column - previous.first_column
     else:
         shift = snapshot.first_id - previous.first_id
-    width = snapshot.data.shape[2]
+    width = snapshot.window().shape[2]
     if not 0 <= shift < width or previous.states[0].frames != width:
         return [None] * channels
     return [state.shifted(shift) for state in previous.states]
@@ -69,7 +69,7 @@ def window_noise(snapshot, residuals, basis, sample=None):
     if source == 'solve':
         return level(residuals)
     projected = level(_sampled(sample, projection_residual(
-        basis, snapshot.data, robust=source != 'least_squares')))
+        basis, snapshot.window(), robust=source != 'least_squares')))
     return np.maximum(projected, level(residuals)) if source == 'max' else projected
 
 
@@ -94,13 +94,12 @@ def solve_window(snapshot):
 
     """
     rows, cols, channels = snapshot.shape
-    snapshot.window()           # the columns stacked here, in the solve's thread
+    window = snapshot.window()  # the columns stacked here, in the solve's thread
     small_shape = _solved_shape(snapshot)
     downscaled = small_shape != tuple(snapshot.shape)
     carried = downscaled or snapshot.refit_background
     started = time.perf_counter()
-    data = (downsample_window(snapshot.data, snapshot.shape, small_shape) if downscaled
-            else snapshot.data)
+    data = downsample_window(window, snapshot.shape, small_shape) if downscaled else window
     try:
         separated = separate_channels(snapshot.model, data, small_shape[:2],
                                       warm_starts(snapshot))
@@ -112,7 +111,7 @@ def solve_window(snapshot):
     rank = int(snapshot.basis_rank)
     if carried:
         # Factors only: the full-size backgrounds are never formed whole.
-        carry = carry_backgrounds(snapshot.data, snapshot.shape, backgrounds, residuals,
+        carry = carry_backgrounds(window, snapshot.shape, backgrounds, residuals,
                                   small_shape, rank)
         bases, newest, mean = carry.bases(rank), carry.newest(), carry.mean()
     else:
@@ -127,20 +126,20 @@ def solve_window(snapshot):
         # A downscaled solve reads its levels at one full-size pixel per
         # solved one, and needs its residual there only.
         sample = PixelSample(snapshot.shape, small_shape) if downscaled else None
+        sampled = _sampled(sample, window)
         if carried:
-            residuals = carry.residuals(snapshot.data,
-                                        None if sample is None else sample.pixels)
+            residuals = carry.residuals(sampled, None if sample is None else sample.pixels)
         noise = window_noise(snapshot, residuals, basis, sample)
         if channels == 3:
-            chroma = chroma_noise(_sampled(sample, snapshot.data), residuals, snapshot.shape,
+            chroma = chroma_noise(sampled, residuals, snapshot.shape,
                                   _sampled(sample, snapshot.observed),
                                   snapshot.decision == 'uniform', sample)
     else:
         # The global rule's threshold costs a median over the whole window; the
         # per-pixel decisions read ``noise`` instead.
         if carried:
-            residuals = carry.residuals(snapshot.data)
-        threshold = snapshot.mask_rule.estimate_threshold(residuals, snapshot.data)
+            residuals = carry.residuals(window)
+        threshold = snapshot.mask_rule.estimate_threshold(residuals, window)
     return BackgroundModel(
         basis=basis, background=newest.reshape(rows, cols, channels),
         mean_background=mean.reshape(rows, cols, channels), threshold=threshold,
