@@ -22,6 +22,7 @@ import time
 
 import cv2
 from dgmod_ros import cli, config
+from dgmod_ros.core.kernels import use_threads
 from dgmod_ros.core.synthetic import synthetic_scene
 from dgmod_ros.inputs import read_frames
 
@@ -31,7 +32,8 @@ HIGHWAY = Path(__file__).resolve().parents[2] / 'shared' / 'data' / 'cdnet_highw
 def detector_rate(frames, values, threaded):
     """Return frames per second of the streaming detector on decoded frames."""
     detector = config.build_detector(values)
-    with ThreadPoolExecutor(max_workers=1) as pool:
+    with ThreadPoolExecutor(max_workers=1, initializer=use_threads,
+                            initargs=(values['solve_threads'],)) as pool:
         started = time.perf_counter()
         for frame in frames:
             detector.process(frame.image, frame.channel_order, executor=pool if threaded else None)

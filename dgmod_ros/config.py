@@ -121,6 +121,10 @@ PARAMETERS = (
     Parameter('stream_max_iter', 5, 'ADMM sweeps per window solve while streaming (node, '
               'stream mode): each solve starts from the last, so sweeps add up over '
               'overlapping windows', 1, 10000),
+    Parameter('solve_threads', 1, "threads of the window solve's compiled kernels where it "
+              'runs beside the per-frame work (the async node, stream mode); 1 leaves the other '
+              'cores to the image callback, DDS and the camera driver; 0 = one per core. The '
+              'masks do not depend on it', 0, 1024, read_only=True),
     # Masks.
     Parameter('decision', 'adaptive', 'adaptive: each pixel against pixel_k times its own noise '
               "level from the window's residual; uniform: one level for all pixels; global: "

@@ -19,6 +19,7 @@ default) configures and activates at once. All numerical work is in
 schedules solves.
 """
 
+from functools import partial
 import sys
 import threading
 import time
@@ -38,6 +39,7 @@ from sensor_msgs.msg import CompressedImage, Image
 from std_srvs.srv import Trigger
 
 from . import config
+from .core.kernels import use_threads
 from .core.masks import overlay
 from .core.preprocess import to_float_channels, to_uint8
 from .core.streaming import SolverFailure
@@ -126,7 +128,9 @@ class DetectorNode(LifecycleNode):
             self._detector = detector
             self._encoding = None
             self._foreground_share = None
-        self._worker = SolveWorker(self._solve, self._on_solved, self._on_solve_error)
+        self._worker = SolveWorker(self._solve, self._on_solved, self._on_solve_error,
+                                   initializer=partial(use_threads,
+                                                       self._values['solve_threads']))
         sensor_qos = {'callback_group': self._image_group, 'qos_overriding_options':
                       QoSOverridingOptions.with_default_policies()}
         if self._values['input_transport'] == 'compressed':

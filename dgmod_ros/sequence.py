@@ -7,6 +7,7 @@ from concurrent.futures import ThreadPoolExecutor
 import cv2
 
 from . import config
+from .core.kernels import use_threads
 from .core.pipeline import batch_separate
 
 
@@ -25,11 +26,14 @@ def stream_results(frames, values):
     are None elsewhere. The solves run in a worker thread beside the per-frame
     work (started as soon as their window is final, installed ``solve_lag``
     frames after they are due); the install rule of the streaming contract
-    makes the masks those of solving in line (the node's sync mode).
+    makes the masks those of solving in line (the node's sync mode). The
+    worker's kernels run on ``solve_threads`` threads, as the node's do.
     """
     detector = config.build_detector(values)
     value_range = values['value_range'] or None
-    with ThreadPoolExecutor(max_workers=1, thread_name_prefix='dgmod-solve') as executor:
+    with ThreadPoolExecutor(max_workers=1, thread_name_prefix='dgmod-solve',
+                            initializer=use_threads,
+                            initargs=(values['solve_threads'],)) as executor:
         for frame in frames:
             result, solved = detector.process(frame.image, frame.channel_order, value_range,
                                               executor=executor)

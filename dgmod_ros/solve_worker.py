@@ -20,13 +20,16 @@ class SolveWorker:
     itself is logged and counted (:attr:`callback_errors`). Whatever happens,
     the job ends: :attr:`busy` is cleared and the thread takes the next job
     (a thread killed by something that is not an ``Exception`` is replaced at
-    the next :meth:`submit`).
+    the next :meth:`submit`). ``initializer()``, if given, runs first in every
+    thread the worker starts (per-thread settings such as the kernels' thread
+    count); an exception from it is logged, and the thread solves without it.
     """
 
-    def __init__(self, solve, on_done, on_error, name='dgmod-solver'):
+    def __init__(self, solve, on_done, on_error, name='dgmod-solver', initializer=None):
         self._solve = solve
         self._on_done = on_done
         self._on_error = on_error
+        self._initializer = initializer
         self._name = name
         self._condition = threading.Condition()
         self._job = None
@@ -73,6 +76,11 @@ class SolveWorker:
         return not self._thread.is_alive()
 
     def _run(self):
+        if self._initializer is not None:
+            try:
+                self._initializer()
+            except Exception as error:  # noqa: B902 - logged; the thread still solves
+                _LOG.error('solve thread initializer raised %r', error, exc_info=error)
         while True:
             with self._condition:
                 self._condition.wait_for(lambda: self._job is not None or self._stopping)

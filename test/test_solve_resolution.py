@@ -2,11 +2,13 @@
 # Licensed under the Apache License, Version 2.0
 """The window solve at a capped size and the full-size background carried from it."""
 
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import replace
 
 import cv2
 from dgmod_ros import config
 from dgmod_ros.core.dgmod import DualGraphMOD
+from dgmod_ros.core.kernels import use_threads
 from dgmod_ros.core.masks import MaskRule
 from dgmod_ros.core.streaming.carry_kernel import normal_equations
 from dgmod_ros.core.streaming.fast_path import background_basis
@@ -19,6 +21,7 @@ from dgmod_ros.core.streaming.solve_resolution import (carry_backgrounds, downsa
                                                        take_pixels)
 from dgmod_ros.core.streaming.window_solve import solve_window
 from dgmod_ros.core.synthetic import synthetic_scene
+import numba
 import numpy as np
 import pytest
 
@@ -310,3 +313,21 @@ def test_a_snapshot_of_columns_solves_as_its_stacked_window(frames):
     for name in ('basis', 'background', 'mean_background', 'noise', 'chroma_noise'):
         assert np.allclose(getattr(from_columns, name), getattr(from_stack, name),
                            atol=1e-5), name
+
+
+def test_a_solve_on_one_kernel_thread_is_the_solve_on_all(frames):
+    # solve_threads changes where the kernels run, never what they compute.
+    values = dict(config.DEFAULTS, window=8, stride=3, min_frames=3, memory_spacing=1,
+                  scale=1.0)
+    detector = config.build_detector(config.validate(values))
+    for frame in frames[:14]:
+        detector.process(frame)
+    snapshot = detector.snapshot()
+    snapshot.window()
+    on_all = solve_window(replace(snapshot))
+    with ThreadPoolExecutor(1, initializer=use_threads, initargs=(1,)) as pool:
+        assert pool.submit(numba.get_num_threads).result() == 1
+        on_one = pool.submit(solve_window, replace(snapshot)).result()
+    assert numba.get_num_threads() == numba.config.NUMBA_NUM_THREADS    # this thread's own
+    for name in ('basis', 'background', 'noise', 'chroma_noise'):
+        assert np.array_equal(getattr(on_one, name), getattr(on_all, name)), name

@@ -117,3 +117,26 @@ def test_a_thread_killed_by_a_base_exception_is_replaced(make_worker):
     assert not worker._thread.is_alive()
     _run(worker, 'next')                      # submit starts a new thread
     assert recorder.done == [('next', 'next')]
+
+
+def test_the_initializer_runs_in_the_worker_thread_and_may_fail(caplog):
+    recorder, names = Recorder(), []
+    worker = SolveWorker(_solve, recorder.on_done, recorder.on_error, name='dgmod-test',
+                         initializer=lambda: names.append(threading.current_thread().name))
+    try:
+        _run(worker, 3)
+    finally:
+        assert worker.stop(timeout=5.0)
+    assert names == ['dgmod-test'] and recorder.done == [(3, 6)]
+
+    def broken():
+        raise RuntimeError('no threads today')
+
+    recorder = Recorder()
+    worker = SolveWorker(_solve, recorder.on_done, recorder.on_error, initializer=broken)
+    try:
+        _run(worker, 4)                       # logged; the thread solves without it
+    finally:
+        assert worker.stop(timeout=5.0)
+    assert recorder.done == [(4, 8)] and recorder.errors == []
+    assert 'no threads today' in caplog.text

@@ -254,6 +254,22 @@ def squared_gap(a, b):
     return sums.sum()
 
 
+def use_threads(count):
+    """
+    Let the kernels that the calling thread starts run on ``count`` threads (0: one per core).
+
+    numba's thread count is a setting of the thread that starts a parallel
+    kernel, so a solve thread can take fewer cores than the machine has and
+    leave one to the image callback, which starts serial kernels only (the
+    ``solve_threads`` parameter; docs/node.md has the measurements). A
+    kernel's result does not depend on it: its blocks of pixels are fixed.
+    Returns the count now in effect.
+    """
+    most = numba.config.NUMBA_NUM_THREADS
+    numba.set_num_threads(min(int(count), most) if count else most)
+    return numba.get_num_threads()
+
+
 def frames_major(matrix):
     """
     Return the ``(m, n)`` C-contiguous transpose of a float32 window ``matrix`` (n, m).
