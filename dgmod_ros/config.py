@@ -104,10 +104,10 @@ PARAMETERS = (
               1e-8, 0.1),
     Parameter('max_iter', 300, 'ADMM sweeps per window solve at most (T_out) in batch mode',
               1, 10000),
-    Parameter('solve_lag', 0, 'frames between the window snapshot of a solve and its install '
-              '(<= stride): the solve runs beside that many frames of per-frame work, and the '
-              'masks do not depend on its speed (sync mode and offline; async installs late '
-              'solves at the first frame after they end)', 0, 300),
+    Parameter('solve_lag', 5, 'frames between the window snapshot of a solve and its install '
+              '(at most stride): the solve runs beside that many frames of per-frame work, and '
+              'the masks do not depend on its speed (sync mode and offline; async installs a '
+              'solve when it ends, about 5 frames at 30 frames/s)', 0, 300),
     Parameter('solve_pixels', 19200, 'largest frame (pixels) the window solve runs at: a '
               'larger one (after solve_scale) is solved scaled down to this, same aspect, and '
               "its full-size background fit from the solve's temporal factors (19200 = 160 x "

@@ -31,7 +31,9 @@ def test_bag_through_node_matches_offline_stream_masks(tmp_path, parameters):
             for connection, _, raw in reader.messages():
                 msg = deserialize_message(raw, Image)          # bytes as recorded
                 node_masks.append(mask_array(harness.send(msg)))
-        assert harness.node.statistics()['solves'] >= 7
+        # Solves at 5 (installed at once), then every 5 frames, each installed
+        # solve_lag = 5 frames later: the one taken at frame 35 is still in flight.
+        assert harness.node.statistics()['solves'] >= 6
     finally:
         harness.close()
 

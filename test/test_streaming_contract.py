@@ -180,7 +180,7 @@ def _process_all(method, frames, executor, **changes):
         masks.append(result.mask)
         if solved is not None:
             installed_at.append(frame_id)
-        if detector.solve_in_flight() and not changes.get('solve_lag'):
+        if detector.solve_in_flight() and not detector.solve_lag:
             started_early_at.append(frame_id)
     return np.stack(masks), installed_at, started_early_at
 
@@ -206,9 +206,10 @@ def test_install_rule_gives_the_same_masks_whatever_the_solve_speed(method, fram
 def test_early_start_gives_the_masks_of_solving_in_line(method, frames):
     # solve_lag 0: with an executor, a solve whose window is final starts before it
     # is due (the window of 8 is full at frame 7; then one admission every 10 frames).
-    inline, installed, started_early = _process_all(method, frames, None)
+    inline, installed, started_early = _process_all(method, frames, None, solve_lag=0)
     assert started_early == []
-    late, late_installed, late_early = _process_all(method, frames, _LastMomentExecutor())
+    late, late_installed, late_early = _process_all(method, frames, _LastMomentExecutor(),
+                                                    solve_lag=0)
     assert np.array_equal(inline, late) and installed == late_installed
     if config.detector_class(_values(method)) is config.SlidingWindowDetector:
         assert installed[:4] == [3, 6, 9, 12]
@@ -274,9 +275,15 @@ def test_failed_solve_is_reported_at_its_frame(frames):
     assert detector.background_model_.states == []      # the next solve starts cold
 
 
-def test_solve_lag_above_the_stride_is_refused():
+def test_solve_lag_above_the_stride_waits_the_stride(frames):
+    # One solve is in flight at a time and the next is due a stride later:
+    # a longer lag (the default 5 with stride 3) installs at the stride.
+    at_stride = _process_all('dgmod', frames, None, solve_lag=3)
+    longer = _process_all('dgmod', frames, None, solve_lag=4)
+    assert np.array_equal(at_stride[0], longer[0]) and at_stride[1] == longer[1]
+    assert at_stride[1][:3] == [3, 9, 12]
     with pytest.raises(ValueError, match='solve_lag'):
-        config.build_detector(_values('dgmod', solve_lag=4))
+        config.build_detector(_values('dgmod', solve_lag=-1))
 
 
 def _finished(model):

@@ -460,8 +460,13 @@ class DualGraphMOD:
             weights = np.exp(-(sigma / self.weight_scale_) ** 2).astype(np.float32)
             L, L_new = L_new, L
             S, S_new = S_new, S
-            # U^T = (left right_t)^T Lh^T, frames-major: one m x m product.
-            np.matmul((left @ right_t).T.astype(np.float32), Lh, out=U)
+            # U^T = (left right_t)^T Lh^T, frames-major: through the k x n factor
+            # left^T Lh^T when the SVT keeps k < m / 2 components (2 k m n
+            # multiply-adds against m^2 n; the background keeps a few of m).
+            if 2 * left.shape[1] < left.shape[0]:
+                np.matmul(right_t.T.astype(np.float32), left.T.astype(np.float32) @ Lh, out=U)
+            else:
+                np.matmul((left @ right_t).T.astype(np.float32), Lh, out=U)
             pending = (_ratio(sums[0], sums[1]), _ratio(sums[2], sums[3]),
                        float(np.sqrt(sums[5])) / data_norm, rank)
         if pending is not None and finish(kernels.squared_gap(U, L)):

@@ -15,8 +15,8 @@ always False and ``install`` refuses every model.
 
 **When a solve is installed.** :meth:`~StreamingDetector.process` installs
 the solve of a snapshot taken at frame ``t`` right before masking frame
-``t + solve_lag`` (``solve_lag`` frames, a detector parameter, 0 by default
-for detectors without it), whether the solve ran in line or in another thread
+``t + solve_lag`` (``solve_lag`` frames, a detector parameter, at most its
+``stride``; 0 for detectors without it), whether the solve ran in line or in another thread
 (``executor``): if it is not finished by then, ``process`` waits for it. The
 masks therefore never depend on how fast a solve runs, and a solve has
 ``solve_lag`` frames of time to run beside the per-frame work. With an
@@ -177,6 +177,9 @@ class StreamingDetector(ABC):
         lag. One solve is in flight at a time.
         """
         lag = int(getattr(self, 'solve_lag', 0)) if snapshot.previous is not None else 0
+        stride = getattr(self, 'stride', None)
+        if stride is not None:          # one solve in flight: the next is due at the stride
+            lag = min(lag, int(stride))
         self.solve_in_flight_ = SolveInFlight(ticket=snapshot.ticket, future=future,
                                               frames_left=int(ahead) + lag)
 

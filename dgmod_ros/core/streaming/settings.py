@@ -71,7 +71,7 @@ def check_window_parameters(detector):
     _require_integer('texture_bits', detector.texture_bits, 0, 48)
     _require_non_negative('moving_texture_k', detector.moving_texture_k)
     _require_integer('moving_texture_bits', detector.moving_texture_bits, 0, 48)
-    _require_integer('solve_lag', detector.solve_lag, 0, stride, f'stride={stride}')
+    _require_integer('solve_lag', detector.solve_lag, 0)
     _require_integer('solve_pixels', detector.solve_pixels, 1)
     _require_scale('solve_scale', detector.solve_scale)
     (detector.mask_rule or MaskRule()).validate()

@@ -166,13 +166,17 @@ class SlidingWindowDetector(StreamingDetector):
         disables.
     moving_texture_bits : int, default=16
         Fewest differing LBSP bits of a changed texture.
-    solve_lag : int, default=0
+    solve_lag : int, default=5
         Frames between a solve's snapshot and its install (at most
-        ``stride``): the solve of the window taken at frame ``t`` becomes the
-        model right before frame ``t + solve_lag`` is masked, so it may run
-        beside ``solve_lag`` frames of per-frame work with the same masks
-        whatever its speed (the install rule of
-        :class:`~dgmod_ros.core.streaming.contract.StreamingDetector`).
+        ``stride``; a larger lag waits ``stride`` frames): the solve of the
+        window taken at frame ``t`` becomes the model right before frame
+        ``t + solve_lag`` is masked, so it may run beside ``solve_lag``
+        frames of per-frame work with the same masks whatever its speed (the
+        install rule of
+        :class:`~dgmod_ros.core.streaming.contract.StreamingDetector`). The
+        default is about when the node's solve thread, which installs a
+        solve when it ends, has one ready at 30 frames/s, so that replays
+        and the offline stream mode see what the live node does.
     solve_pixels : int, default=19200
         Largest frame (pixels) the window solve runs at. A larger solve
         (after ``solve_scale``) is scaled down to at most this many pixels,
@@ -218,7 +222,7 @@ class SlidingWindowDetector(StreamingDetector):
                  hold_changes=False, absorb_frames=300, decision='adaptive',
                  noise_source='solve', pixel_k=6.0, median_size=5, ghost_test=True,
                  still_frames=25, mrf_beta=2.0, chroma_cue=True, texture_cue=True,
-                 texture_bits=8, moving_texture_k=3.0, moving_texture_bits=16, solve_lag=0,
+                 texture_bits=8, moving_texture_k=3.0, moving_texture_bits=16, solve_lag=5,
                  solve_pixels=19200, solve_scale=0.5, refit_background=True):
         self.model = model
         self.window = window
