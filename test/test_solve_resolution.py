@@ -298,16 +298,22 @@ def test_a_snapshot_holds_its_window_while_frames_go_on(frames):
     assert snapshot.frames().flags.c_contiguous and snapshot.frames().shape[0] == 8
 
 
-def test_a_snapshot_of_columns_solves_as_its_stacked_window(frames):
-    # The node hands over columns, stacked frames-major; tests and benchmarks
-    # a C-ordered (C, n, m) window. Both solve to the same model.
+def _detector_snapshot(frames):
+    """Return a snapshot of buffered columns, downscaled and refit as at the defaults."""
     values = dict(config.DEFAULTS, window=8, stride=3, min_frames=3, memory_spacing=1,
                   scale=1.0)
     detector = config.build_detector(config.validate(values))
     for frame in frames[:14]:
         detector.process(frame)
     snapshot = detector.snapshot()
-    assert snapshot.solve_shape != snapshot.shape      # downscaled and refit: the defaults
+    assert snapshot.solve_shape != snapshot.shape and snapshot.refit_background
+    return snapshot
+
+
+def test_a_snapshot_of_columns_solves_as_its_stacked_window(frames):
+    # The node hands over columns, stacked frames-major; tests and benchmarks
+    # a C-ordered (C, n, m) window. Both solve to the same model.
+    snapshot = _detector_snapshot(frames)
     stacked = replace(snapshot, data=np.stack(snapshot.data, axis=2))
     from_columns, from_stack = solve_window(snapshot), solve_window(stacked)
     for name in ('basis', 'background', 'mean_background', 'noise', 'chroma_noise'):
@@ -317,12 +323,7 @@ def test_a_snapshot_of_columns_solves_as_its_stacked_window(frames):
 
 def test_a_solve_on_one_kernel_thread_is_the_solve_on_all(frames):
     # solve_threads changes where the kernels run, never what they compute.
-    values = dict(config.DEFAULTS, window=8, stride=3, min_frames=3, memory_spacing=1,
-                  scale=1.0)
-    detector = config.build_detector(config.validate(values))
-    for frame in frames[:14]:
-        detector.process(frame)
-    snapshot = detector.snapshot()
+    snapshot = _detector_snapshot(frames)
     snapshot.window()
     on_all = solve_window(replace(snapshot))
     with ThreadPoolExecutor(1, initializer=use_threads, initargs=(1,)) as pool:
