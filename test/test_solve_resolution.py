@@ -295,7 +295,8 @@ def test_a_snapshot_holds_its_window_while_frames_go_on(frames):
     assert np.array_equal(snapshot.window(), expected)
     assert snapshot.window() is snapshot.data and snapshot.data.shape[2] == 8
     # Stacked frames-major: each frame's channels are one contiguous block.
-    assert snapshot.frames().flags.c_contiguous and snapshot.frames().shape[0] == 8
+    frames = snapshot.window().transpose(2, 0, 1)                        # (m, C, n)
+    assert frames.flags.c_contiguous and frames.shape[0] == 8
 
 
 def _detector_snapshot(frames):

@@ -117,15 +117,11 @@ class WindowSnapshot:
         frames-major, (m, C, n) in memory, and the window is the (C, n, m)
         view of that: a stack along the new last axis is a strided scatter
         that took ten times as long (docs/node.md), and the solve reads the
-        window frame by frame (:meth:`frames`) anyway.
+        window frame by frame anyway.
         """
         if not isinstance(self.data, np.ndarray):
             self.data = np.stack(self.data, axis=0).transpose(1, 2, 0)
         return self.data
-
-    def frames(self):
-        """Return the window frame by frame, (m, C, n): the transposed view of :meth:`window`."""
-        return self.window().transpose(2, 0, 1)
 
 
 @dataclass

@@ -48,7 +48,7 @@ def _sampled(sample, array):
     return array if sample is None or array is None else sample.take(array)
 
 
-def window_noise(snapshot, residuals, basis, sample=None):
+def window_noise(snapshot, residuals, basis, observed, sample=None):
     """
     Return each pixel's noise level from the residual ``snapshot.noise_source`` names.
 
@@ -57,11 +57,11 @@ def window_noise(snapshot, residuals, basis, sample=None):
     basis (the statistic the per-frame decision thresholds); 'max': the
     larger of the 'solve' and 'projection' levels. With a
     :class:`~.solve_resolution.PixelSample`, the levels are read at its
-    pixels (``residuals`` holds those only) and upsampled.
+    pixels (``residuals`` and ``observed``, the snapshot's observed entries,
+    hold those only) and upsampled.
     """
     uniform = snapshot.decision == 'uniform'
     source = snapshot.noise_source
-    observed = _sampled(sample, snapshot.observed)
 
     def level(residual):
         return pixel_noise(residual, snapshot.shape, observed, uniform=uniform, sample=sample)
@@ -126,13 +126,12 @@ def solve_window(snapshot):
         # A downscaled solve reads its levels at one full-size pixel per
         # solved one, and needs its residual there only.
         sample = PixelSample(snapshot.shape, small_shape) if downscaled else None
-        sampled = _sampled(sample, window)
+        sampled, observed = _sampled(sample, window), _sampled(sample, snapshot.observed)
         if carried:
             residuals = carry.residuals(sampled, None if sample is None else sample.pixels)
-        noise = window_noise(snapshot, residuals, basis, sample)
+        noise = window_noise(snapshot, residuals, basis, observed, sample)
         if channels == 3:
-            chroma = chroma_noise(sampled, residuals, snapshot.shape,
-                                  _sampled(sample, snapshot.observed),
+            chroma = chroma_noise(sampled, residuals, snapshot.shape, observed,
                                   snapshot.decision == 'uniform', sample)
     else:
         # The global rule's threshold costs a median over the whole window; the
