@@ -7,7 +7,7 @@ from dgmod_ros.core.streaming.background_memory import held_pixels
 from dgmod_ros.core.streaming.coherence import mean_field_mask
 from dgmod_ros.core.streaming.fast_path import projection_residual, robust_projection
 from dgmod_ros.core.streaming.foreground import (adaptive_mask, consecutive_frames,
-                                                 moving_texture_k, warmup_noise)
+                                                 moving_texture_k, pixel_noise, warmup_noise)
 from dgmod_ros.core.streaming.held_foreground import still_blob_pixels
 import numpy as np
 import pytest
@@ -302,3 +302,69 @@ def test_the_window_keeps_out_what_passes_under_the_threshold():
     # The column admitted at frame 39, when the box covered columns 39-46.
     assert not _newest_column_observed(True)[12:28, 41:45].any()
     assert _newest_column_observed(False)[12:28, 41:45].all()
+
+
+def _quiet_residual(rows, cols, columns, seed=6):
+    """Return a window residual (1, n, m) of Gaussian noise 0.01."""
+    rng = np.random.default_rng(seed)
+    return rng.normal(0, 0.01, (1, rows * cols, columns)).astype(np.float32)
+
+
+def test_pixel_noise_counts_the_observed_columns_while_they_are_half():
+    rows, cols, columns = 12, 12, 10
+    residual = _quiet_residual(rows, cols, columns)
+    observed = np.ones((rows * cols, columns), bool)
+    block = np.zeros((rows, cols), bool)
+    # A person in 5 of 10 columns, which its masks saw (top-left block), and
+    # in 7, which leaves 3 observed columns: fewer than half (bottom-right).
+    for rows_, cols_, passed in (((0, 6), (0, 6), 5), ((6, 12), (6, 12), 7)):
+        block[:] = False
+        block[slice(*rows_), slice(*cols_)] = True
+        residual[0, block.ravel(), :passed] += 0.5
+        observed[block.ravel(), :passed] = False
+    noise = pixel_noise(residual, (rows, cols, 1), observed).reshape(rows, cols)
+    typical = float(np.median(noise))
+    assert noise[2, 2] < 1.5 * typical                   # its own quiet columns
+    # All ten columns: the median of 7 large and 3 quiet is large.
+    assert noise[9, 9] > 0.5
+    # Without the masks' help the first block's median mixes quiet and large.
+    assert pixel_noise(residual, (rows, cols, 1)).reshape(rows, cols)[2, 2] > 0.1
+
+
+def test_pixel_noise_smoothing_keeps_a_noisy_region_inside_its_border():
+    rows, cols = 20, 20
+    residual = _quiet_residual(rows, cols, 12)
+    region = np.zeros((rows, cols), bool)
+    region[5:15, 5:15] = True
+    residual[0, region.ravel()] *= 10                    # a screen's flicker
+    noise = pixel_noise(residual, (rows, cols, 1)).reshape(rows, cols)
+    typical = float(np.median(noise[~region]))
+    assert noise[6, 10] > 5 * typical                    # inside, next to the edge
+    # Outside, next to the edge: a 5 x 5 box filter would put 2/5 of the
+    # region's level there.
+    assert noise[4, 10] < 1.5 * typical and noise[10, 3] < 1.5 * typical
+
+
+@pytest.mark.parametrize('conditional_update', [True, False])
+def test_the_filling_window_admits_frames_as_they_are_without_their_foreground_in_the_noise(
+        conditional_update):
+    rng = np.random.default_rng(7)
+    wall = rng.uniform(0.3, 0.7, (30, 40, 3)).astype(np.float32)
+    detector = SlidingWindowDetector(window=12, scale=1.0, min_frames=3,
+                                     conditional_update=conditional_update)
+    for index in range(8):                               # a model, the window not full
+        image = wall + rng.normal(0, 0.004, wall.shape).astype(np.float32)
+        image[8:20, 2 + 3 * index:10 + 3 * index] = 0.05       # a dark box walks in
+        image = np.clip(image, 0, 1)
+        result, _ = detector.process(image)
+    assert detector.background_model_ is not None and len(detector.buffer_) == 8
+    assert result.mask[10:18, 25:31].all()
+    newest = detector.buffer_.columns()[-1].reshape(3, 30, 40)
+    np.testing.assert_array_equal(newest, np.moveaxis(image, 2, 0))   # as it is
+    observed = detector.buffer_.observed()
+    if not conditional_update:
+        assert observed is None
+        return
+    observed = observed[:, -1].reshape(30, 40)
+    assert not observed[10:18, 25:31].any()              # the box: left out of the noise
+    assert observed[25:, :].all()                        # the wall below it: counted

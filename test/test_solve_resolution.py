@@ -83,13 +83,24 @@ def test_noise_levels_read_at_the_sample_and_upsampled_match_every_pixels():
         (chroma_noise(data, residual, shape),
          chroma_noise(sample.take(data), sample.take(residual), shape, sample=sample)),
     )
+    patch = np.zeros(shape[:2], np.uint8)
+    patch[10:30, 8:24] = 1
+    square = np.ones((3, 3), np.uint8)
+    border = (cv2.dilate(patch, square) > cv2.erode(patch, square)).ravel()
     for every, sampled in pairs:
         assert sampled.shape == every.shape == (level.size,) and sampled.dtype == np.float32
         error = np.abs(sampled - every) / every
-        # Measured: median 0.9% / 1.4%, 90th percentile 4.9% / 6.0%, largest 13% / 12%.
+        # Measured: median 0.9% / 1.2%, 90th percentile 6.2% / 7.4%, largest
+        # off the patch's border 20% / 18%.
         assert np.median(error) < 0.03
         assert np.percentile(error, 90) < 0.1
-        assert error.max() < 0.25
+        assert error[~border].max() < 0.25
+        # On it the coarser grid may put the edge one pixel off: each level
+        # lies within those of its 3 x 3 neighbourhood, give or take the
+        # sample's own error (measured 0.87 to 1.12 times their range).
+        image = every.reshape(shape[:2])
+        low, high = cv2.erode(image, square).ravel(), cv2.dilate(image, square).ravel()
+        assert np.all(sampled >= 0.8 * low) and np.all(sampled <= 1.25 * high)
 
 
 def test_frames_major_windows_resample_and_sample_as_pixel_major_ones():

@@ -11,7 +11,10 @@ the window spans ``m * spacing`` frames, and it admits a frame
 conditionally: where the frame's own mask says foreground, the column holds
 the current background instead of the frame (the pixel counts as not
 observed). A person who stops therefore stays foreground, while everything
-the masks call background keeps refreshing the model. A pixel that has been
+the masks call background keeps refreshing the model. While the window
+fills, frames go in as they are, their foreground only marked as not
+observed, so that the noise levels of the first solves leave out a person
+the first masks saw. A pixel that has been
 foreground for ``absorb_frames`` frames in a row is admitted as it is, so an
 object that stays (or a mistake of the masks) joins the background after
 about ``absorb_frames + m * spacing / 2`` frames, when the l1 fit lets the
@@ -68,7 +71,7 @@ class BackgroundMemory(FrameWindow):
         return frame_id - self.last_admitted_id >= self.spacing
 
     def append(self, columns, frame_id, observed=None):
-        """Admit a frame's columns (C, n); ``observed`` (n,) bool marks the frame's own pixels."""
+        """Admit a frame's columns (C, n); ``observed`` (n,) bool marks the pixels noise counts."""
         super().append(columns, frame_id)
         self._observed.append(observed)
         self.admitted += 1
@@ -110,9 +113,14 @@ class BackgroundMemory(FrameWindow):
         self._observed = deque([None] * len(self), maxlen=self.capacity)
 
 
-def conditional_columns(columns, background, foreground, foreground_age, absorb_frames):
+def conditional_columns(columns, background, foreground, foreground_age, absorb_frames,
+                        replace=True):
     """
     Return the columns to admit and their observed pixels (conditional update).
+
+    The observed pixels are those the noise levels count
+    (:func:`~dgmod_ros.core.streaming.foreground.pixel_noise`): the frame's
+    own pixels where its mask called it background.
 
     Parameters
     ----------
@@ -124,12 +132,18 @@ def conditional_columns(columns, background, foreground, foreground_age, absorb_
         Consecutive frames each pixel has been foreground.
     absorb_frames : int
         Foreground older than this is admitted as it is.
+    replace : bool
+        Put the background in place of the foreground; False (the window
+        still filling) admits the frame as it is, its foreground only not
+        observed.
 
     """
-    replaced = foreground & (foreground_age < absorb_frames)
-    if not replaced.any():
+    held = foreground & (foreground_age < absorb_frames)
+    if not held.any():
         return columns, None
-    return np.where(replaced[None, :], background, columns), ~replaced
+    if replace:
+        columns = np.where(held[None, :], background, columns)
+    return columns, ~held
 
 
 def held_pixels(mask, away, changing, away_age, young_frames):

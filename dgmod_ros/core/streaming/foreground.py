@@ -7,15 +7,22 @@ One threshold for the whole frame treats a flickering monitor and a flat
 wall alike. Here every pixel gets ``k`` times its own noise level ``sigma_p``,
 read from the last window solve: the median of ``|D - L|`` (largest over the
 colour channels) over the window's columns in which the pixel was observed
-(not filled in by the conditional update, see
+(its frame's mask called it background, see
 :mod:`~dgmod_ros.core.streaming.background_memory`), times 1.4826 (the
-standard deviation for Gaussian noise). The median ignores the columns in
-which the pixel was foreground, as long as they are fewer than half. No pixel
-is taken as quieter than the frame's typical pixel (the median of
+standard deviation for Gaussian noise). Leaving out the columns the masks
+called foreground keeps a passing person from raising the level, which a
+median alone does only while the person is in fewer than half of the
+columns: a young window of a few consecutive frames often has a walker in
+most of them. A pixel observed in fewer than half of the columns takes the
+median over all of them instead: the masks, not the pixel, are in doubt
+there (leaves that the first masks took for foreground keep their level).
+No pixel is taken as quieter than the frame's typical pixel (the median of
 ``sigma_p`` over the frame): only noisy places get a higher threshold, and a
 pixel seen fewer than :data:`MIN_OBSERVED` times gets the typical level. The
-levels are smoothed over a 5 x 5 neighbourhood, which shares the noise of a
-surface (leaves, a screen).
+levels are smoothed by the median of a 5 x 5 neighbourhood, which shares the
+noise of a surface (leaves, a screen) without spreading a region's level
+over its border (a box filter carried a walker's raised level 2 pixels out,
+into the pixels where the walker comes next).
 
 A frame's distance to its background is the largest absolute difference
 over the channels (colour catches a person whose grey level matches the
@@ -37,7 +44,7 @@ from ..masks import robust_sigma
 MIN_OBSERVED = 3
 # Gaussian consistency factor of the median absolute value.
 _MAD_TO_SIGMA = 1.4826
-# Side of the box filter that smooths the noise levels.
+# Side of the median filter that smooths the noise levels (3 or 5: float32 input).
 _NOISE_SMOOTHING = 5
 # Smallest noise level: one grey level of 8-bit data.
 _QUANTUM = 1.0 / 255.0
@@ -79,7 +86,8 @@ def pixel_noise(residual, shape, observed=None, uniform=False, sample=None):
     shape : tuple (rows, cols, C)
         Processing shape.
     observed : ndarray (n, m) bool or None
-        Entries that hold the frame's own pixel (with ``sample``: (k, m)); None: all.
+        Entries counted in the level: the frame's own pixel, where its mask
+        called it background (with ``sample``: (k, m)); None: all.
     uniform : bool
         Give every pixel the typical level (the ablation of the per-pixel rule).
     sample : PixelSample or None
@@ -91,6 +99,11 @@ def pixel_noise(residual, shape, observed=None, uniform=False, sample=None):
     rows, cols = shape[:2]
     magnitude = np.abs(residual).max(axis=0)                     # (n, m)
     median, count = observed_median(magnitude, observed)
+    if observed is not None:
+        doubtful = count < magnitude.shape[1] / 2
+        if doubtful.any():
+            median[doubtful] = observed_median(magnitude[doubtful])[0]
+            count[doubtful] = magnitude.shape[1]
     sigma = _MAD_TO_SIGMA * median
     seen = count >= MIN_OBSERVED
     typical = float(np.median(sigma[seen])) if np.any(seen) else robust_sigma(magnitude)
@@ -102,7 +115,7 @@ def pixel_noise(residual, shape, observed=None, uniform=False, sample=None):
         # Upsampled unsmoothed, so that the smoothing below spans the same
         # neighbourhood of the frame as at every pixel.
         sigma = sample.upsample(sigma)
-    smooth = cv2.blur(sigma.reshape(rows, cols), (_NOISE_SMOOTHING, _NOISE_SMOOTHING))
+    smooth = cv2.medianBlur(sigma.reshape(rows, cols), _NOISE_SMOOTHING)
     return smooth.ravel()
 
 

@@ -79,7 +79,9 @@ def chroma_noise(data, residual, shape, observed=None, uniform=False, sample=Non
     shape : tuple (rows, cols, C)
         Processing shape.
     observed : ndarray (n, m) bool or None
-        Entries that hold the frame's own pixel (with ``sample``: (k, m)); None: all.
+        Entries the level counts, as for
+        :func:`~dgmod_ros.core.streaming.foreground.pixel_noise` (with
+        ``sample``: (k, m)); None: all.
     uniform : bool
         Give every pixel the typical level.
     sample : PixelSample or None

@@ -99,7 +99,7 @@ class WindowSnapshot:
     mask_rule: object           # likewise the MaskRule
     basis_rank: int             # likewise the fast path's basis size
     ticket: SolveTicket = None
-    observed: np.ndarray = None  # (n, m) bool: entries holding the frame's own pixel; None: all
+    observed: np.ndarray = None  # (n, m) bool: entries the noise levels count; None: all
     first_column: int = None    # admission count of the oldest column (warm-start shift)
     decision: str = 'global'    # likewise the decision rule ('adaptive' needs pixel noise)
     noise_source: str = 'solve'  # likewise the residual the pixel noise comes from

@@ -102,7 +102,9 @@ class SlidingWindowDetector(StreamingDetector):
     conditional_update : bool, default=True
         Admit a frame with its foreground (the mask, dilated by 5 x 5 at the
         processing size) replaced by the background, so that a person who
-        stops is not learned into the background.
+        stops is not learned into the background. While the window fills,
+        frames go in as they are and their foreground is only left out of
+        the noise levels.
     hold_changes : bool, default=False
         The conditional update also keeps out the pixels over ``pixel_k / 2``
         noise levels from the background that are as far from the frame 5
@@ -435,18 +437,21 @@ class SlidingWindowDetector(StreamingDetector):
                 or self.buffer_.is_motionless(columns, self.motion_threshold)):
             return False
         observed = None
-        # While the window fills, every frame goes in as it is: the first
-        # solves must separate whatever moves in the first frames, and a
-        # model learnt from a few frames is no ground for holding pixels back.
-        if (self.conditional_update and self.background_model_ is not None
-                and len(self.buffer_) >= self.buffer_.capacity):
+        if self.conditional_update:
+            # While the window fills, every frame goes in as it is: the first
+            # solves must separate whatever moves in the first frames, and a
+            # model learnt from a few frames is no ground for holding pixels
+            # back. Its foreground is only left out of the noise levels.
+            replace = (self.background_model_ is not None
+                       and len(self.buffer_) >= self.buffer_.capacity)
             held = foreground
-            if self.hold_changes and self.decision != 'global':
+            if replace and self.hold_changes and self.decision != 'global':
                 held = self._held(columns, foreground, distance, level)
             # Dilated: a silhouette's border is foreground below the threshold.
             grown = cv2.dilate(held, _BORDER_KERNEL).ravel() > 0
             columns, observed = conditional_columns(columns, background, grown,
-                                                    self.foreground_age_, self.absorb_frames)
+                                                    self.foreground_age_, self.absorb_frames,
+                                                    replace)
         self.buffer_.append(columns, frame_id, observed)
         return True
 
