@@ -118,7 +118,7 @@ PARAMETERS = (
     Parameter('refit_background', True, "the background is each pixel's own series fit on "
               "the solve's leading temporal factors, the solve's foreground held out, also "
               "when the solve runs at the processing size; false: the solve's own L there"),
-    Parameter('stream_max_iter', 5, 'ADMM sweeps per window solve while streaming (node, '
+    Parameter('stream_max_iter', 3, 'ADMM sweeps per window solve while streaming (node, '
               'stream mode): each solve starts from the last, so sweeps add up over '
               'overlapping windows', 1, 10000),
     Parameter('solve_threads', 1, "threads of the window solve's compiled kernels where it "

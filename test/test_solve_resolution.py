@@ -206,7 +206,7 @@ def test_carried_basis_reproduces_a_full_size_low_rank_background():
 
 
 def test_refit_at_the_solve_size_keeps_what_moved_out_of_background_and_noise():
-    # A short solve (5 sweeps, as in streaming) leaves a smear of the moving
+    # A short solve (5 sweeps; streaming runs 3) leaves a smear of the moving
     # block in L: its residual, and so the noise level, is inflated along the
     # block's path. The refit holds the block's entries out of each pixel's fit.
     truth, data = _low_rank_window()

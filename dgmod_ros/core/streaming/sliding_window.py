@@ -60,9 +60,10 @@ class SlidingWindowDetector(StreamingDetector):
         Object with ``fit(data, frame_shape, init=None)`` setting
         ``background_``, ``foreground_`` and optionally ``state_``,
         ``n_iter_``, ``info_``. None: :class:`DualGraphMOD` with ``tol=1e-3``
-        and at most 5 sweeps per solve: every solve starts from the previous
-        one, so sweeps add up over overlapping windows (``docs/solver.md``
-        has the measured effect of the sweep count).
+        and at most 3 sweeps per solve: every solve starts from the previous
+        one, so sweeps add up over overlapping windows, and the refit takes
+        only the solve's temporal factors (``docs/results.md`` has the
+        measured effect of the sweep count).
     window : int, default=30
         Columns ``m`` kept in the window.
     stride : int, default=10
@@ -277,7 +278,7 @@ class SlidingWindowDetector(StreamingDetector):
 
     def _build_helpers(self):
         self.model_ = (self.model if self.model is not None
-                       else DualGraphMOD(tol=1e-3, max_iter=5))
+                       else DualGraphMOD(tol=1e-3, max_iter=3))
         self.mask_rule_ = self.mask_rule or MaskRule()
         self.lighting_ = (LightingTest(self.chroma_cue, self.texture_cue, int(self.texture_bits))
                           if self.chroma_cue or self.texture_cue else None)
