@@ -27,6 +27,7 @@ from dataclasses import replace
 import time
 
 from dgmod_ros import config
+from dgmod_ros.core.kernels import use_threads
 from dgmod_ros.core.preprocess import frame_columns
 from dgmod_ros.core.streaming import solve_resolution, window_solve
 from dgmod_ros.core.streaming.results import WindowSnapshot
@@ -35,6 +36,7 @@ from dgmod_ros.core.synthetic import synthetic_scene
 import numpy as np
 
 CASES = (('defaults (scale 0.5)', {}),
+         ('defaults, 5 sweeps (before)', {'stream_max_iter': 5}),
          ('scale=1.0, capped', {'scale': 1.0}),
          ('defaults before', {'solve_scale': 1.0, 'refit_background': False,
                               'solve_pixels': 320 * 240}),
@@ -100,7 +102,11 @@ def main():
     """Time each case's warm-started solve, interleaved; print ms and ratios."""
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--repeats', type=int, default=3)
+    parser.add_argument('--threads', type=int, default=0,
+                        help="the kernels' threads (the node and stream mode run "
+                             "solve_threads, 1); 0: numba's default, every core")
     args = parser.parse_args()
+    use_threads(args.threads)
     frames = list(synthetic_scene(n_frames=40, shape=(480, 640), seed=3).frames)
     windows = [snapshots(values, frames) for _, values in CASES]
     times = [[] for _ in CASES]
