@@ -31,7 +31,7 @@ from .core.preprocess import to_uint8
 from .core.runtime import keep_freed_memory
 from .evaluation import evaluate
 from .inputs import BadInput, count_frames, read_frames
-from .sequence import load_kernels, results
+from .sequence import results
 
 
 class Progress:
@@ -253,7 +253,7 @@ def separate(args):
     # Before the clock: the report's rate is the stream's, and start-up is
     # reported apart (loaded lazily, the kernels had cost a 300-frame run 7%).
     loading = time.perf_counter()
-    load_kernels(values)
+    config.load_kernels(values)
     started = time.perf_counter()
     windows = []
     writer = PngWriter()

@@ -265,6 +265,21 @@ def detector_class(values):
     return OpenCVSubtractor if values['method'] in _OPENCV_METHODS else SlidingWindowDetector
 
 
+def load_kernels(values):
+    """
+    Load the compiled kernels that ``values['method']`` runs (numba's disk cache).
+
+    Once per process, about 0.4 s from the cache: a start-up cost like the
+    imports. Loaded lazily, they would cost the first frame that much (the
+    node lost the 5 frames after its first to its input queue meanwhile),
+    and a caller timing the frames would count them. OpenCV's subtractors
+    need none.
+    """
+    if detector_class(values) is SlidingWindowDetector:
+        from .core.kernels import compile_all       # numba: imported when needed
+        compile_all()
+
+
 def detector_settings(values):
     """Return the keyword arguments of the streaming detector the values describe."""
     if detector_class(values) is OpenCVSubtractor:

@@ -124,6 +124,7 @@ class DetectorNode(LifecycleNode):
         except ValueError as error:
             self.get_logger().error(f'configure failed: {error}')
             return TransitionCallbackReturn.FAILURE
+        config.load_kernels(self._values)      # before the first frame, not in its callback
         with self._lock:
             self._detector = detector
             self._encoding = None

@@ -7,26 +7,13 @@ from concurrent.futures import ThreadPoolExecutor
 import cv2
 
 from . import config
-from .core.kernels import compile_all, use_threads
+from .core.kernels import use_threads
 from .core.pipeline import batch_separate
-from .core.streaming import SlidingWindowDetector
 
 
 def _at_input_size(background, frame):
     return cv2.resize(background, frame.image.shape[1::-1]).reshape(
         frame.image.shape[:2] + (-1,))
-
-
-def load_kernels(values):
-    """
-    Load the compiled kernels that ``values['method']`` runs (numba's disk cache).
-
-    Once per process, and about 0.4 s from the cache: a start-up cost like
-    the imports, which a caller timing the frames runs first (OpenCV's
-    subtractors need none).
-    """
-    if config.detector_class(values) is SlidingWindowDetector:
-        compile_all()
 
 
 def stream_results(frames, values):
