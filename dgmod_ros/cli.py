@@ -251,7 +251,7 @@ def separate(args):
     progress = Progress(f'{values["method"]} {args.mode}', count_frames(args.input, args.topic),
                         stream=io.StringIO() if args.quiet else sys.stderr)
     # Before the clock: the report's rate is the stream's, and start-up is
-    # reported apart (loaded lazily, the kernels had cost a 300-frame run 7%).
+    # reported apart (docs/node.md).
     loading = time.perf_counter()
     config.load_kernels(values)
     started = time.perf_counter()

@@ -120,7 +120,7 @@ def solve_window(snapshot):
         mean = np.stack([b.mean(axis=1) for b in backgrounds], axis=1)
     # The frames are in [0, 1], and so is the image a planner reads: the
     # refit of a pixel the window saw in few frames extrapolates where its
-    # newest frames were held out (-0.73 to 1.29 on IBMtest2's solves).
+    # newest frames were held out (docs/results.md).
     newest, mean = np.clip(newest, 0, 1), np.clip(mean, 0, 1)
     basis = np.zeros((channels, rows * cols, max(b.shape[1] for b in bases)), dtype=np.float32)
     for channel, channel_basis in enumerate(bases):
