@@ -7,7 +7,8 @@ Builds each case's window from the same synthetic 640 x 480 colour scene at
 its processing size (the defaults: 320 x 240, solved at 160 x 120 and
 refit; the defaults before 2026-12-01: 320 x 240 solved as it is, no refit;
 ``scale=1.0``: 640 x 480, solved at ``solve_pixels`` and carried back;
-``scale=1.0`` uncapped: solved at 640 x 480), solves it once cold, then
+``scale=1.0`` uncapped: solved at 640 x 480; the defaults with 5 sweeps
+per solve, the count before 2026-12-01), solves it once cold, then
 times the warm-started solve of the window one frame on, the cases
 interleaved so that the machine's load falls on all alike. Each snapshot
 holds the buffered columns, as the detector hands them over, so that the
@@ -18,7 +19,7 @@ goes (the carry, the noise levels). Asserts nothing.
 Usage::
 
     OPENBLAS_NUM_THREADS=1 PYTHONPATH=. .venv/bin/python benchmarks/bench_capped_solve.py
-        [--repeats 3]
+        [--repeats 3] [--threads 1]
 """
 
 import argparse

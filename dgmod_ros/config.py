@@ -270,9 +270,9 @@ def load_kernels(values):
     Load the compiled kernels that ``values['method']`` runs (numba's disk cache).
 
     Once per process: a start-up cost like the imports. Loaded lazily, they
-    would cost the first frame that much (the node lost the frames after its
-    first to its input queue meanwhile: docs/node.md), and a caller timing
-    the frames would count them. OpenCV's subtractors need none.
+    would stall the first frame (the node lost the frames after its first to
+    its input queue meanwhile: docs/node.md), and a caller timing the frames
+    would count them. OpenCV's subtractors need none.
     """
     if detector_class(values) is SlidingWindowDetector:
         from .core.kernels import compile_all       # numba: imported when needed
