@@ -3,7 +3,7 @@
 """The fast path's compiled l1 projection against its numpy formulation."""
 
 from dgmod_ros.core.streaming.fast_path import (background_basis, fit_step, robust_projection,
-                                                robust_projection_reference)
+                                                robust_projection_reference, sampled_basis)
 import numpy as np
 import pytest
 
@@ -52,6 +52,11 @@ def test_sampled_fit_equals_numpy(rank):
     basis, frame, _ = _frame_and_basis(rank)
     assert np.allclose(robust_projection(basis, frame, fit_pixels=700),
                        robust_projection_reference(basis, frame, fit_pixels=700), atol=1e-5)
+    # A solve forms the sampled basis once for every frame until the next.
+    kept = sampled_basis(basis, fit_pixels=700)
+    assert kept.shape[1] == 750 and kept.flags.c_contiguous
+    assert np.array_equal(robust_projection(basis, frame, fit_pixels=700, fit_basis=kept),
+                          robust_projection(basis, frame, fit_pixels=700))
 
 
 def test_sampled_fit_projects_every_pixel_as_the_full_fit_does():

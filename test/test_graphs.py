@@ -1,7 +1,7 @@
 # Copyright 2026 dgmod_ros authors
 # Licensed under the Apache License, Version 2.0
-from dgmod_ros.core.graphs import (banded_matrix, spatial_laplacian, spatial_laplacian_bands,
-                                   temporal_laplacian)
+from dgmod_ros.core.graphs import (banded_matrix, normalized_laplacian, spatial_laplacian,
+                                   spatial_laplacian_bands, temporal_laplacian)
 from dgmod_ros.core.linalg import gram_matrix
 import numpy as np
 import pytest
@@ -17,7 +17,7 @@ def window():
 
 
 def _check_normalized_laplacian(laplacian, degree_vector):
-    dense = laplacian.toarray().astype(np.float64)
+    dense = (laplacian.toarray() if sp.issparse(laplacian) else laplacian).astype(np.float64)
     assert np.allclose(dense, dense.T, atol=1e-6)
     eigenvalues = np.linalg.eigvalsh(dense)
     assert eigenvalues.min() > -1e-5                           # positive semi-definite
@@ -70,7 +70,7 @@ def test_spatial_weights_follow_patch_similarity(window):
 def test_temporal_laplacian_properties(window):
     data, _ = window
     laplacian, h = temporal_laplacian(data, neighbors=4)
-    dense = laplacian.toarray()
+    dense = laplacian
     m = data.shape[1]
     assert dense.shape == (m, m) and h > 0
     # Only frames within two steps are joined.
@@ -86,7 +86,31 @@ def test_temporal_laplacian_from_a_given_gram_is_the_same(window):
     alone, h_alone = temporal_laplacian(data, neighbors=4)
     shared, h_shared = temporal_laplacian(data, neighbors=4, gram=gram_matrix(data))
     assert h_alone == h_shared
-    assert np.array_equal(alone.toarray(), shared.toarray())
+    assert np.array_equal(alone, shared)
+
+
+def test_normalized_laplacian_is_the_sparse_product():
+    # The dense m x m form replaced I - W^-1/2 A W^-1/2 in scipy.sparse. Its
+    # degrees are summed in another order (an ulp in float64); the float32
+    # matrix the solver applies is the same.
+    rng = np.random.default_rng(5)
+    m = 9
+    adjacency = np.zeros((m, m))
+    for offset in (1, 2):
+        weights = rng.random(m - offset)
+        adjacency[np.arange(m - offset), np.arange(offset, m)] = weights
+        adjacency[np.arange(offset, m), np.arange(m - offset)] = weights
+    adjacency[4, :] = adjacency[:, 4] = 0.0                    # an isolated frame
+    sparse = sp.csr_matrix(adjacency)
+    degree = np.asarray(sparse.sum(axis=1)).ravel()
+    inv_sqrt = np.zeros_like(degree)
+    np.divide(1.0, np.sqrt(degree), out=inv_sqrt, where=degree > 0)
+    scale = sp.diags(inv_sqrt)
+    expected = (sp.diags((degree > 0).astype(float)) - scale @ sparse @ scale).toarray()
+    laplacian = normalized_laplacian(adjacency)
+    assert np.allclose(laplacian, expected, rtol=0, atol=1e-15)
+    assert np.array_equal(laplacian.astype(np.float32), expected.astype(np.float32))
+    assert laplacian[4, 4] == 0.0 and not laplacian[4].any()
 
 
 def test_default_filtering_parameter_is_median_edge_distance(window):

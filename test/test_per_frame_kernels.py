@@ -3,7 +3,7 @@
 """The per-frame path's compiled kernels give their numpy references' results bit for bit."""
 
 import cv2
-from dgmod_ros.core.preprocess import frame_columns
+from dgmod_ros.core.preprocess import frame_columns, to_float_channels
 from dgmod_ros.core.streaming import lighting_kernel, mean_field_kernel
 from dgmod_ros.core.streaming.blobs import BlobMotion, moving_share_reference
 from dgmod_ros.core.streaming.coherence import mean_field_mask, mean_field_mask_reference
@@ -192,6 +192,26 @@ def test_bgr_frames_give_the_columns_of_their_channels_reversed(dtype, channels)
         got, shape = frame_columns(image, scale, 'rgb', 'bgr')
         expected, expected_shape = frame_columns(reference, scale, 'rgb', 'rgb')
         assert shape == expected_shape and np.array_equal(got, expected)
+
+
+@pytest.mark.parametrize('dtype', [np.uint8, np.uint16, np.int16])
+@pytest.mark.parametrize('channels, order', [(3, 'rgb'), (3, 'bgr'), (4, 'bgr'), (4, 'rgb')])
+def test_half_size_colour_columns_are_the_general_conversion_bit_for_bit(dtype, channels, order):
+    # frame_columns takes one compiled pass for an integer colour frame at
+    # scale 0.5; the general path (float frame, OpenCV's area resize, columns)
+    # is the reference, value_range clipping and negative values included.
+    rng = np.random.default_rng(channels + len(order))
+    top = np.iinfo(dtype).max
+    image = rng.integers(np.iinfo(dtype).min, top, (48, 64, channels), endpoint=True,
+                         dtype=dtype)
+    image[0, :4] = top                                  # full scale: exactly 1.0
+    for value_range in (None, 1000.0):
+        got, shape = frame_columns(image, 0.5, 'rgb', order, value_range)
+        channels_first = to_float_channels(image, order, 'rgb', value_range)
+        small = cv2.resize(channels_first, (32, 24), interpolation=cv2.INTER_AREA)
+        assert shape == (24, 32, 3)
+        assert np.array_equal(got, small.reshape(-1, 3).T)
+        assert got.dtype == np.float32 and got.flags.c_contiguous
 
 
 @pytest.mark.parametrize('seed', range(4))

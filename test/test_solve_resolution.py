@@ -15,7 +15,8 @@ from dgmod_ros.core.streaming.fast_path import background_basis
 from dgmod_ros.core.streaming.foreground import pixel_noise
 from dgmod_ros.core.streaming.photometric import chroma_noise
 from dgmod_ros.core.streaming.results import WindowSnapshot
-from dgmod_ros.core.streaming.solve_resolution import (carry_backgrounds, downsample_window,
+from dgmod_ros.core.streaming.solve_resolution import (carry_backgrounds, ColumnCache,
+                                                       downsample_window,
                                                        PixelSample, resample_columns,
                                                        resample_frames, solve_shape, solve_spd,
                                                        take_pixels)
@@ -121,6 +122,10 @@ def test_frames_major_windows_resample_and_sample_as_pixel_major_ones():
     assert picked.flags.c_contiguous and np.array_equal(picked, plain[:, pixels])
     assert np.array_equal(take_pixels(plain, pixels), picked)
     assert np.array_equal(take_pixels(plain[0], pixels), plain[0, pixels])
+    for small_shape in (HALF, (7, 11)):         # by rows and columns, any ratio
+        sample = PixelSample(FULL, small_shape)
+        for array in (view, view[0], plain):
+            assert np.array_equal(sample.take(array), np.take(array, sample.pixels, axis=-2))
 
 
 @pytest.mark.parametrize('r', [1, 2, 3])
@@ -344,3 +349,49 @@ def test_a_solve_on_one_kernel_thread_is_the_solve_on_all(frames):
     assert numba.get_num_threads() == numba.config.NUMBA_NUM_THREADS    # this thread's own
     for name in ('basis', 'background', 'noise', 'chroma_noise'):
         assert np.array_equal(getattr(on_one, name), getattr(on_all, name)), name
+
+
+def test_column_cache_gives_the_stacked_windows_copies_and_makes_each_once(monkeypatch):
+    rng = np.random.default_rng(4)
+    shape, small_shape = (48, 64, 3), (20, 27, 3)                   # not an integer ratio
+    columns = [rng.random((3, 48 * 64), dtype=np.float32) for _ in range(6)]
+    window = np.stack(columns, axis=0).transpose(1, 2, 0)           # as WindowSnapshot.window
+    sample = PixelSample(shape, small_shape)
+    cache = ColumnCache()
+    small = cache.small_window(columns, shape, small_shape)
+    assert small[0].flags.f_contiguous
+    assert np.array_equal(small, downsample_window(window, shape, small_shape))
+    assert np.array_equal(cache.sampled_window(columns, sample), sample.take(window))
+    # One column moves in: only its copies are made.
+    made = []
+    real = resample_frames
+    monkeypatch.setattr('dgmod_ros.core.streaming.solve_resolution.resample_frames',
+                        lambda *args: made.append(args[0]) or real(*args))
+    moved = columns[1:] + [rng.random((3, 48 * 64), dtype=np.float32)]
+    cache.keep(moved)
+    again = cache.small_window(moved, shape, small_shape)
+    assert len(made) == 1 and made[0] is moved[-1]
+    assert np.array_equal(again[:, :, :-1], small[:, :, 1:])
+    assert id(columns[0]) not in cache._entries
+
+
+def test_a_snapshot_of_columns_and_their_cache_solves_as_the_stacked_window():
+    # The detector hands over its buffered columns and its ColumnCache; the
+    # model is the one of the stacked window, before and after a cache hit.
+    _, data = _low_rank_window()
+    shape = (FULL[0], FULL[1], 3)
+    window = np.repeat(data, 3, axis=0) * np.array([1.0, 0.8, 0.6], np.float32)[:, None, None]
+    columns = tuple(np.ascontiguousarray(window[:, :, j]) for j in range(window.shape[2]))
+    cache = ColumnCache()
+
+    def snapshot(data, column_cache):
+        return WindowSnapshot(
+            data=data, shape=shape, first_id=0, last_id=len(columns) - 1, previous=None,
+            model=DualGraphMOD(tol=1e-3, max_iter=5), mask_rule=MaskRule(), basis_rank=2,
+            decision='adaptive', solve_shape=(24, 32, 3), refit_background=True,
+            column_cache=column_cache)
+    plain = solve_window(snapshot(window, None))
+    for _ in range(2):
+        cached = solve_window(snapshot(columns, cache))
+        for name in ('basis', 'background', 'noise', 'chroma_noise'):
+            assert np.array_equal(getattr(cached, name), getattr(plain, name)), name

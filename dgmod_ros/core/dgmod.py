@@ -6,7 +6,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .graphs import banded_matrix, spatial_laplacian_bands, temporal_laplacian
+from .graphs import (banded_matrix, diagonal_bands, spatial_laplacian_bands,
+                     temporal_laplacian)
 from .linalg import (drop_oldest, gram_eigh, gram_matrix, mixing_factors, relative_change,
                      shrink, singular_value_map, top_singular_value)
 from .runtime import limit_blas_threads
@@ -404,7 +405,7 @@ class DualGraphMOD:
         coefficients = np.array([g1, g2, c, rho1, rho2, step, self.lambda2 / rho2, 1.0 / rho2])
         s_offsets, s_bands = ops['phi_s_bands']
         # The kernel reads Phi_t[j, j + off]; Phi_t is symmetric, so its own bands serve.
-        t_offsets, t_bands = kernels.diagonal_bands(ops['phi_t'])
+        t_offsets, t_bands = ops['phi_t_bands']
         # Other L-steps than one gradient step run in numpy and hand L_new over.
         l_given = not (self.l_step == 'gradient' and self.inner_iter == 1)
         L_new, S_new = np.empty_like(D), np.empty_like(D)
@@ -480,17 +481,20 @@ class DualGraphMOD:
         """
         Graph Laplacians, the temporal eigenbasis and the data's Gram matrix for one window.
 
-        ``phi_s_bands`` holds the spatial Laplacian's diagonal bands (what the
-        fused sweep applies); the sparse ``phi_s`` of the numpy steps is formed
-        from them on first use only.
+        ``phi_s_bands`` and ``phi_t_bands`` hold the Laplacians' diagonal bands
+        (what the fused sweep applies); ``phi_t`` is dense (m x m), and the
+        sparse ``phi_s`` of the numpy steps is formed from its bands on first
+        use only.
         """
         offsets, bands, self.h_s_ = spatial_laplacian_bands(
             data, frame_shape, self.patch_size, self.h_s, self.smoothing_sigma)
         gram = gram_matrix(data)
         phi_t, self.h_t_ = temporal_laplacian(data, self.temporal_neighbors, self.h_t, gram)
-        mu, basis = np.linalg.eigh(phi_t.toarray())
-        return _Operators(phi_s_bands=(offsets, bands), phi_t=phi_t.astype(np.float32).toarray(),
-                          basis=basis.astype(np.float32), mu=mu, data_gram=gram)
+        mu, basis = np.linalg.eigh(phi_t)
+        phi_t = phi_t.astype(np.float32)
+        return _Operators(phi_s_bands=(offsets, bands), phi_t=phi_t,
+                          phi_t_bands=diagonal_bands(phi_t), basis=basis.astype(np.float32),
+                          mu=mu, data_gram=gram)
 
     def objective(self, data, frame_shape):
         """

@@ -20,17 +20,18 @@ from .linalg import gram_matrix
 
 def normalized_laplacian(adjacency):
     """
-    Return ``I - W^-1/2 A W^-1/2`` (sparse CSR) for a symmetric adjacency ``A``.
+    Return ``I - W^-1/2 A W^-1/2`` (dense, float64) for a dense symmetric adjacency ``A``.
 
     Isolated vertices (degree 0) get a zero row: they carry no smoothing.
+    The m x m matrix of a window's frames is small: scipy.sparse's
+    per-operation overhead had cost a hundred times its arithmetic.
     """
-    adjacency = sp.csr_matrix(adjacency)
-    degree = np.asarray(adjacency.sum(axis=1)).ravel()
+    adjacency = np.asarray(adjacency, dtype=np.float64)
+    degree = adjacency.sum(axis=1)
     inv_sqrt = np.zeros_like(degree)
     np.divide(1.0, np.sqrt(degree), out=inv_sqrt, where=degree > 0)
-    scale = sp.diags(inv_sqrt)
-    identity = sp.diags((degree > 0).astype(adjacency.dtype))
-    return (identity - scale @ adjacency @ scale).tocsr().astype(adjacency.dtype)
+    scaled = (inv_sqrt[:, None] * adjacency) * inv_sqrt[None, :]
+    return np.diag((degree > 0).astype(np.float64)) - scaled
 
 
 def _gaussian_weights(sq_dist, h):
@@ -62,7 +63,7 @@ def temporal_laplacian(data, neighbors=4, h=None, gram=None):
 
     Returns
     -------
-    laplacian : scipy.sparse.csr_matrix (m, m), float64
+    laplacian : ndarray (m, m), float64
     h : float, the filtering parameter used.
 
     """
@@ -76,13 +77,14 @@ def temporal_laplacian(data, neighbors=4, h=None, gram=None):
         rows.append(np.arange(m - offset))
         cols.append(np.arange(offset, m))
     if not rows:
-        return sp.csr_matrix((m, m)), 1.0 if h is None else float(h)
+        return np.zeros((m, m)), 1.0 if h is None else float(h)
     rows = np.concatenate(rows)
     cols = np.concatenate(cols)
     sq_dist = np.clip(sq_norm[rows] + sq_norm[cols] - 2.0 * gram[rows, cols], 0.0, None)
     weights, h_used = _gaussian_weights(sq_dist, h)
-    adjacency = sp.coo_matrix((np.r_[weights, weights], (np.r_[rows, cols], np.r_[cols, rows])),
-                              shape=(m, m))
+    adjacency = np.zeros((m, m))
+    adjacency[rows, cols] = weights
+    adjacency[cols, rows] = weights
     return normalized_laplacian(adjacency), h_used
 
 
@@ -185,6 +187,31 @@ def spatial_laplacian_bands(data, frame_shape, patch_size=3, h=None, smoothing_s
             bands[-shift * step] = coupling.ravel()
     offsets = np.array(sorted(bands), dtype=np.int64)
     return offsets, np.stack([bands[o] for o in offsets]), h_used
+
+
+def diagonal_bands(matrix):
+    """
+    Return ``(offsets, bands)`` with ``matrix[i, i + offsets[k]] == bands[k, i]``.
+
+    ``matrix`` is square (scipy sparse or dense); ``bands`` is float32 of shape
+    ``(len(offsets), n)``, zero where ``i + offset`` leaves the matrix. The
+    graph Laplacians are banded (4-neighbour pixels in row-major order:
+    offsets 0, +-1, +-n2; frames: the temporal reach), so a product with them
+    is a few shifted multiply-adds per row that the compiler vectorises.
+    """
+    if sp.issparse(matrix):
+        coo = sp.coo_matrix(matrix)
+        coo.sum_duplicates()
+        rows, cols, values = coo.row, coo.col, coo.data
+    else:
+        rows, cols = np.nonzero(matrix)
+        values = matrix[rows, cols]
+    n = matrix.shape[0]
+    diff = cols.astype(np.int64) - rows.astype(np.int64)
+    offsets = np.unique(diff)
+    bands = np.zeros((offsets.size, n), dtype=np.float32)
+    bands[np.searchsorted(offsets, diff), rows] = values
+    return offsets.astype(np.int64), bands
 
 
 def banded_matrix(offsets, bands):

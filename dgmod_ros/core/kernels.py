@@ -60,8 +60,8 @@ os.environ.setdefault('NUMBA_THREADING_LAYER', 'threadsafe')
 import numba  # noqa: E402 (the cache folder must be set before numba reads its config)
 from numba import njit, prange  # noqa: E402
 import numpy as np  # noqa: E402
-import scipy.sparse as sp  # noqa: E402
 
+from .graphs import diagonal_bands  # noqa: E402,F401 (the bands the pass applies)
 from .linalg import c_order  # noqa: E402
 from .runtime import limit_blas_threads  # noqa: E402
 
@@ -74,26 +74,6 @@ limit_blas_threads(1)
 # loops, blocks few enough per thread to amortise the per-block scratch
 # rows, many enough (75 at 320 x 240) to balance two to eight threads.
 _BLOCK_PIXELS = 1024
-
-
-def diagonal_bands(matrix):
-    """
-    Return ``(offsets, bands)`` with ``matrix[i, i + offsets[k]] == bands[k, i]``.
-
-    ``matrix`` is square (scipy sparse or dense); ``bands`` is float32 of shape
-    ``(len(offsets), n)``, zero where ``i + offset`` leaves the matrix. The
-    graph Laplacians are banded (4-neighbour pixels in row-major order:
-    offsets 0, +-1, +-n2; frames: the temporal reach), so a product with them
-    is a few shifted multiply-adds per row that the compiler vectorises.
-    """
-    coo = sp.coo_matrix(matrix)
-    coo.sum_duplicates()
-    n = coo.shape[0]
-    diff = coo.col.astype(np.int64) - coo.row.astype(np.int64)
-    offsets = np.unique(diff)
-    bands = np.zeros((offsets.size, n), dtype=np.float32)
-    bands[np.searchsorted(offsets, diff), coo.row] = coo.data
-    return offsets.astype(np.int64), bands
 
 
 @njit(cache=True, inline='always')
@@ -293,6 +273,8 @@ def compile_all():
     data = np.linspace(0.0, 1.0, 12 * 4, dtype=np.float32).reshape(12, 4)
     DualGraphMOD(max_iter=1).fit(data, (3, 4))
     DualGraphMOD(max_iter=1, l_step='exact').fit(data, (3, 4))
+    from .halving_kernel import compile_kernel as compile_halving
+    compile_halving()                                     # a frame to columns at scale 0.5
     from .streaming.irls_kernel import compile_kernel     # the fast path's projection
     compile_kernel()
     from .streaming.mean_field_kernel import compile_kernel as compile_field

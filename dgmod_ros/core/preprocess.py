@@ -109,8 +109,17 @@ def frame_columns(frame, scale, color='gray', channel_order='rgb', value_range=N
     frame = np.asarray(frame)
     if frame.ndim < 2 or frame.shape[0] == 0 or frame.shape[1] == 0:
         raise ValueError(f'frame must be a non-empty image, got shape {frame.shape}')
+    rows, cols = processing_shape(frame.shape[:2], scale)
+    if (color == 'rgb' and frame.ndim == 3 and frame.shape[2] in (3, 4)
+            and frame.dtype.kind in 'ui' and frame.shape[:2] == (2 * rows, 2 * cols)
+            and channel_order in ('rgb', 'bgr')):
+        # A colour camera at scale 0.5: the same columns in one pass (halving_kernel).
+        full_scale = unit_scale(frame.dtype) if value_range is None else float(value_range)
+        if full_scale > 0:
+            from .halving_kernel import half_columns        # numba: loaded on first use
+            return (half_columns(frame, np.float32(1.0 / full_scale), channel_order == 'bgr'),
+                    (rows, cols, 3))
     channels = to_float_channels(frame, channel_order, color, value_range)
-    rows, cols = processing_shape(channels.shape[:2], scale)
     small = resize(channels, (rows, cols)).reshape(rows, cols, -1)
     return small.reshape(rows * cols, -1).T.copy(), (rows, cols, small.shape[2])
 

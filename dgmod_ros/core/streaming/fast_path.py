@@ -38,7 +38,19 @@ def background_basis(background, max_rank=None):
     return left
 
 
-def robust_projection(basis, columns, fit_pixels=None):
+def sampled_basis(basis, fit_pixels=None):
+    """
+    Return the basis (C, n, r) at the pixels the IRLS sweeps weigh, C-contiguous.
+
+    The same for every frame until the next solve, which therefore forms it
+    once (:attr:`~.results.BackgroundModel.fit_basis`) instead of each frame.
+    """
+    basis = np.ascontiguousarray(basis, dtype=np.float32)
+    step = fit_step(basis.shape[1], fit_pixels)
+    return basis if step == 1 else np.ascontiguousarray(basis[:, ::step])
+
+
+def robust_projection(basis, columns, fit_pixels=None, fit_basis=None):
     """
     l1-fit each channel's column onto its basis by IRLS; return the fitted columns.
 
@@ -57,6 +69,8 @@ def robust_projection(basis, columns, fit_pixels=None):
         One frame, one column per channel.
     fit_pixels : int or None
         Most pixels the sweeps weigh; None: ``FIT_PIXELS``.
+    fit_basis : ndarray or None
+        ``sampled_basis(basis, fit_pixels)`` where the caller keeps it; None forms it.
 
     """
     from .irls_kernel import weighted_normal_equations    # numba: loaded on first use
@@ -67,10 +81,9 @@ def robust_projection(basis, columns, fit_pixels=None):
     gram = np.empty((channels, rank, rank))
     rhs = np.empty((channels, rank))
     step = fit_step(n, fit_pixels)
-    fit_basis, fit_columns = basis, columns
-    if step > 1:
-        fit_basis = np.ascontiguousarray(basis[:, ::step])
-        fit_columns = np.ascontiguousarray(columns[:, ::step])
+    if fit_basis is None:
+        fit_basis = sampled_basis(basis, fit_pixels)
+    fit_columns = columns if step == 1 else np.ascontiguousarray(columns[:, ::step])
     for _ in range(_IRLS_SWEEPS):
         weighted_normal_equations(fit_basis, fit_columns, coef, _IRLS_FLOOR, gram, rhs)
         for channel in range(channels):

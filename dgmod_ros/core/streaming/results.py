@@ -105,6 +105,7 @@ class WindowSnapshot:
     noise_source: str = 'solve'  # likewise the residual the pixel noise comes from
     solve_shape: tuple = None   # (rows, cols, C) the window is solved at; None: ``shape``
     refit_background: bool = False  # refit each pixel's series on the solve's factors
+    column_cache: object = None  # ColumnCache of the columns in ``data`` (solve_resolution)
 
     def window(self):
         """
@@ -159,6 +160,9 @@ class BackgroundModel:
     solve_shape : tuple or None
         (rows, cols, C) the window was solved at (the warm start's size);
         None: ``shape``.
+    fit_basis : ndarray or None
+        ``basis`` at the pixels the fast path's IRLS sweeps weigh
+        (:func:`~.fast_path.sampled_basis`); None: formed per frame.
 
     """
 
@@ -178,3 +182,4 @@ class BackgroundModel:
     first_column: int = None
     chroma_noise: np.ndarray = None
     solve_shape: tuple = None
+    fit_basis: np.ndarray = None

@@ -23,7 +23,7 @@ from .held_foreground import still_blob_pixels
 from .photometric import LightingTest
 from .results import FrameResult, WindowSnapshot
 from .settings import assign_validated, check_window_parameters
-from .solve_resolution import solve_shape
+from .solve_resolution import ColumnCache, solve_shape
 from .window_solve import solve_window
 from ..dgmod import DualGraphMOD
 from ..masks import MaskRule
@@ -326,6 +326,7 @@ class SlidingWindowDetector(StreamingDetector):
         """Forget every buffered frame and the background model."""
         self._new_generation()
         self.buffer_ = BackgroundMemory(int(self.window), int(self.memory_spacing))
+        self.column_cache_ = ColumnCache()
         self.foreground_age_ = None
         self.still_age_ = None
         self.away_age_ = None
@@ -369,7 +370,7 @@ class SlidingWindowDetector(StreamingDetector):
             # The frame itself counts: with one frame buffered there is no other difference.
             with_frame = np.concatenate((buffered, columns[:, :, None]), axis=2)
             return background, warmup_noise(with_frame)
-        background = robust_projection(model.basis, columns)
+        background = robust_projection(model.basis, columns, fit_basis=model.fit_basis)
         if self.decision == 'global':
             if model.threshold is None:     # solved for a per-pixel decision (switched since)
                 return background, self.mask_rule_.threshold_from_noise(model.noise)
@@ -546,7 +547,8 @@ class SlidingWindowDetector(StreamingDetector):
                               noise_source=self.noise_source,
                               solve_shape=solve_shape(self.shape_, int(self.solve_pixels),
                                                       float(self.solve_scale)),
-                              refit_background=bool(self.refit_background))
+                              refit_background=bool(self.refit_background),
+                              column_cache=self.column_cache_)
 
     def solve(self, snapshot):
         """

@@ -110,19 +110,78 @@ def downsample_window(data, shape, small_shape):
     return small.transpose(0, 2, 1)
 
 
-def take_pixels(array, pixels):
+class ColumnCache:
+    """
+    Each buffered column's copy at the solve size and at the noise levels' pixels, made once.
+
+    A capped solve reads its whole window downscaled and at a
+    :class:`PixelSample` of pixels, a pass over 27 MB at 640 x 480 each time,
+    while between two solves one column in the window's thirty is new (one
+    admission per ``memory_spacing`` frames, one solve per ``stride``).
+    Buffered columns are never written (:meth:`~.buffer.FrameWindow.columns`),
+    so each column's downscaled and sampled copies are made the first time a
+    solve asks and kept while the column is in a solved window. Every copy is
+    the same arithmetic as :func:`downsample_window` and :func:`take_pixels`
+    on the stacked window, per column. A solve thread reads and fills the
+    cache; a detector's solves run one at a time, and one left running by a
+    reset works on the cache of its own snapshot.
+    """
+
+    def __init__(self):
+        self._entries = {}      # id(column) -> (column, {key: copy})
+
+    def _copy(self, column, key, make):
+        entry = self._entries.get(id(column))
+        if entry is None or entry[0] is not column:     # an id reused by a new column
+            entry = self._entries[id(column)] = (column, {})
+        copy = entry[1].get(key)
+        if copy is None:
+            copy = entry[1][key] = make(column)
+        return copy
+
+    def keep(self, columns):
+        """Forget the copies of every column not in ``columns``."""
+        alive = {id(column) for column in columns}
+        for key in list(self._entries):
+            if key not in alive:
+                self._entries.pop(key, None)
+
+    def small_window(self, columns, shape, small_shape):
+        """Return the window of ``columns`` (C, n) at ``small_shape``, as downsample_window."""
+        key = ('area', tuple(shape[:2]), tuple(small_shape[:2]))
+        small = np.stack([self._copy(column, key, lambda c: resample_frames(
+            c, shape, small_shape, cv2.INTER_AREA)) for column in columns], axis=1)
+        return small.transpose(0, 2, 1)                                    # (C, n', m)
+
+    def sampled_window(self, columns, sample):
+        """Return the window of ``columns`` (C, n) at ``sample``'s pixels, as its ``take``."""
+        key = ('sample', sample.shape, sample.small_shape)
+        picked = np.stack([self._copy(column, key, lambda c: np.take(c, sample.pixels, axis=1))
+                           for column in columns])                         # (m, C, k)
+        return np.ascontiguousarray(np.moveaxis(picked, 0, -1))
+
+
+def take_pixels(array, pixels, grid=None):
     """
     Return ``array`` (n, m) or (C, n, m) at ``pixels`` of its second-to-last axis, C-ordered.
 
     A frames-major window (pixels the faster axis in memory,
     :meth:`~.results.WindowSnapshot.window`) is gathered along its rows and
     the small result transposed: a gather across its frames' strides cost
-    several times as much.
+    several times as much. ``grid`` = (rows, cols, picked rows, picked
+    columns), where ``pixels`` is that grid's row-major product, gathers the
+    rows and then the columns of each frame: half the time of a gather of
+    single pixels, the same values.
     """
     frames = np.moveaxis(array, -1, 0)                  # (m, ..., n)
     if array.ndim > 1 and frames.flags.c_contiguous:
         # np.take of a strided array copies it whole first: take from the rows.
-        picked = np.take(frames.reshape(-1, frames.shape[-1]), pixels, axis=1)
+        if grid is None:
+            picked = np.take(frames.reshape(-1, frames.shape[-1]), pixels, axis=1)
+        else:
+            rows, cols, picked_rows, picked_cols = grid
+            images = frames.reshape(-1, rows, cols)
+            picked = np.take(np.take(images, picked_rows, axis=1), picked_cols, axis=2)
         return np.ascontiguousarray(np.moveaxis(picked.reshape(frames.shape[:-1] + (-1,)), 0, -1))
     return np.take(array, pixels, axis=-2)
 
@@ -156,12 +215,14 @@ class PixelSample:
         (rows, cols), (small_rows, small_cols) = self.shape, self.small_shape
         picked_rows = ((np.arange(small_rows) + 0.5) * (rows / small_rows)).astype(np.intp)
         picked_cols = ((np.arange(small_cols) + 0.5) * (cols / small_cols)).astype(np.intp)
-        self.pixels = (np.minimum(picked_rows, rows - 1)[:, None] * cols
-                       + np.minimum(picked_cols, cols - 1)[None, :]).ravel()
+        picked_rows = np.minimum(picked_rows, rows - 1)
+        picked_cols = np.minimum(picked_cols, cols - 1)
+        self.pixels = (picked_rows[:, None] * cols + picked_cols[None, :]).ravel()
+        self._grid = (rows, cols, picked_rows, picked_cols)
 
     def take(self, array):
-        """Return ``array``'s picked pixels (:func:`take_pixels`)."""
-        return take_pixels(array, self.pixels)
+        """Return ``array``'s picked pixels (:func:`take_pixels`, by rows and columns)."""
+        return take_pixels(array, self.pixels, self._grid)
 
     def upsample(self, levels):
         """Return (n,) float32 levels bilinearly upsampled from one per picked pixel (k,)."""

@@ -6,7 +6,7 @@ import time
 
 import numpy as np
 
-from .fast_path import background_basis, projection_residual
+from .fast_path import background_basis, projection_residual, sampled_basis
 from .foreground import pixel_noise
 from .photometric import chroma_noise
 from .results import BackgroundModel, SolverFailure
@@ -94,12 +94,22 @@ def solve_window(snapshot):
 
     """
     rows, cols, channels = snapshot.shape
+    # The columns each downscaled and sampled once (ColumnCache), when the
+    # snapshot holds buffered columns and their cache.
+    columns, cache = snapshot.data, snapshot.column_cache
+    if isinstance(columns, np.ndarray) or cache is None:
+        columns = cache = None
+    else:
+        cache.keep(columns)
     window = snapshot.window()  # the columns stacked here, in the solve's thread
     small_shape = _solved_shape(snapshot)
     downscaled = small_shape != tuple(snapshot.shape)
     carried = downscaled or snapshot.refit_background
     started = time.perf_counter()
-    data = downsample_window(window, snapshot.shape, small_shape) if downscaled else window
+    data = window
+    if downscaled:
+        data = (downsample_window(window, snapshot.shape, small_shape) if cache is None
+                else cache.small_window(columns, snapshot.shape, small_shape))
     try:
         separated = separate_channels(snapshot.model, data, small_shape[:2],
                                       warm_starts(snapshot))
@@ -130,7 +140,11 @@ def solve_window(snapshot):
         # A downscaled solve reads its levels at one full-size pixel per
         # solved one, and needs its residual there only.
         sample = PixelSample(snapshot.shape, small_shape) if downscaled else None
-        sampled, observed = _sampled(sample, window), _sampled(sample, snapshot.observed)
+        if sample is not None and cache is not None:
+            sampled = cache.sampled_window(columns, sample)
+        else:
+            sampled = _sampled(sample, window)
+        observed = _sampled(sample, snapshot.observed)
         if carried:
             residuals = carry.residuals(sampled, None if sample is None else sample.pixels)
         noise = window_noise(snapshot, residuals, basis, observed, sample)
@@ -150,4 +164,4 @@ def solve_window(snapshot):
         states=separated.states, seconds=time.perf_counter() - started,
         iterations=separated.iterations, info=separated.info, ticket=snapshot.ticket,
         noise=noise, first_column=snapshot.first_column, chroma_noise=chroma,
-        solve_shape=small_shape)
+        solve_shape=small_shape, fit_basis=sampled_basis(basis))

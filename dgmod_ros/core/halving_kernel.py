@@ -1,0 +1,62 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""
+A frame to float columns at half size in one compiled pass (the default robot camera's path).
+
+:func:`~dgmod_ros.core.preprocess.frame_columns` converts a frame to float32
+in [0, 1] at full size, averages 2 x 2 areas (OpenCV's ``INTER_AREA``) and
+transposes the result into per-channel columns: four passes over a 640 x 480
+frame in the per-frame path. For an integer colour frame of even size at
+``scale`` 0.5, :func:`half_columns` does the same arithmetic in one pass over
+the frame and writes the columns directly: each value scaled and clipped as
+:func:`~dgmod_ros.core.preprocess.to_float_channels` does, and the area
+``(((a + b) + c) + d) * 0.25`` in the order of OpenCV's integer-ratio area
+resize, so the columns are the same bit for bit (``test/test_per_frame_kernels.py``).
+Importing :mod:`dgmod_ros.core.kernels` first makes its process-wide numba
+settings hold here too; the pass is serial and ``nogil`` (the image callback's).
+"""
+
+from numba import njit
+import numpy as np
+
+# numba's cache folder and threading layer, set before the decorator below runs.
+from . import kernels  # noqa: F401
+
+
+@njit(cache=True, nogil=True)
+def _half_columns(image, scale, reverse, out):
+    rows, cols = image.shape[0] // 2, image.shape[1] // 2
+    quarter = np.float32(0.25)
+    one = np.float32(1.0)
+    zero = np.float32(0.0)
+    for channel in range(out.shape[0]):
+        source = out.shape[0] - 1 - channel if reverse else channel
+        for i in range(rows):
+            top = image[2 * i]
+            bottom = image[2 * i + 1]
+            row = out[channel, i * cols:(i + 1) * cols]
+            for j in range(cols):
+                a = min(max(np.float32(top[2 * j, source]) * scale, zero), one)
+                b = min(max(np.float32(top[2 * j + 1, source]) * scale, zero), one)
+                c = min(max(np.float32(bottom[2 * j, source]) * scale, zero), one)
+                d = min(max(np.float32(bottom[2 * j + 1, source]) * scale, zero), one)
+                row[j] = (((a + b) + c) + d) * quarter
+
+
+def half_columns(image, scale, reverse):
+    """
+    Return the (3, n) float32 columns of an integer (h, w, >= 3) frame at half its size.
+
+    ``scale`` is the float32 factor to [0, 1] (``1 / value_range``);
+    ``reverse`` takes the first three channels in reverse order (BGR input).
+    ``h`` and ``w`` must be even.
+    """
+    rows, cols = image.shape[0] // 2, image.shape[1] // 2
+    out = np.empty((3, rows * cols), dtype=np.float32)
+    _half_columns(image, np.float32(scale), bool(reverse), out)
+    return out
+
+
+def compile_kernel():
+    """Compile (or load from the cache) the pass on a tiny frame."""
+    half_columns(np.zeros((2, 2, 3), dtype=np.uint8), 1.0 / 255, False)
