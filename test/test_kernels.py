@@ -73,6 +73,24 @@ def test_fused_solve_stops_where_numpy_stops_and_warm_starts_alike():
     assert_same_iterates(second[0], second[1], atol=1e-4)
 
 
+@pytest.mark.parametrize('shift', [0, 4])
+def test_fused_solve_reads_its_warm_start_without_writing_it(shift):
+    # The fused pass updates V, Y2 and Lh in place and swaps L and S with
+    # its own buffers: a warm start, which with a shift of 0 is the previous
+    # model's own state, must come out as it went in.
+    data = scene_window()
+    previous = DualGraphMOD(tol=1e-3).fit(data[:, :-4], SHAPE)
+    init = previous.state_.shifted(shift)
+    before = {name: getattr(init, name).copy() for name in STATE}
+    window = data[:, shift:data.shape[1] - 4 + shift]
+    for max_iter in (1, 2, 5):
+        model = DualGraphMOD(tol=1e-12, max_iter=max_iter).fit(window, SHAPE, init=init)
+        assert model.n_iter_ == max_iter
+        for name in STATE:
+            assert np.array_equal(getattr(init, name), before[name]), name
+            assert not np.shares_memory(getattr(model.state_, name), getattr(init, name)), name
+
+
 @pytest.mark.filterwarnings('ignore:overflow encountered', 'ignore:invalid value encountered')
 def test_non_finite_iterate_stops_both_engines_alike():
     # A gradient step far beyond 1 / Lipschitz diverges to inf within a few sweeps.

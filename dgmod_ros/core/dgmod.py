@@ -382,9 +382,9 @@ class DualGraphMOD:
         Sweep with the compiled pass of :mod:`dgmod_ros.core.kernels`.
 
         The same steps as :meth:`_run_numpy` in the same order, the same
-        iterates and the same stopping sweep; after the primal pass BLAS forms
-        the Gram matrix of ``Lh = L - Y1`` and the SVT as the rank-k product
-        ``U = (Lh left) right_t``. ``Y1`` lives as ``U - Lh`` (kernels module
+        iterates and the same stopping sweep; the primal pass also sums the
+        Gram matrix of the next ``Lh = L - Y1``, and BLAS forms the SVT as the
+        rank-k product ``U = (Lh left) right_t``. ``Y1`` lives as ``U - Lh`` (kernels module
         docstring) and is formed once, at the end. The pass runs on the
         frames-major transposes of the iterates (:func:`kernels.frames_major`);
         the iterates handed back are ``n x m`` views of them (F-ordered), so a
@@ -435,13 +435,12 @@ class DualGraphMOD:
                 np.subtract(U, Lh, out=Y1)
                 self._l_rhs(data, U.T, Y1.T, S.T, V.T, Y2.T, rhs.T, work.T)
                 np.copyto(L_new.T, self._l_step(rhs.T, L.T, ops, c))
-            sums = kernels.primal_pass(
+            sums, gram = kernels.primal_pass(
                 D, L, U, Lh, S, V, Y2, s_offsets, s_bands, t_offsets, t_bands,
                 coefficients, l_given, L_new, S_new)
             if pending is not None:
                 finish(sums[4])     # not below tol: pending's own figures are not
                 pending = None
-            gram = Lh @ Lh.T
             if not (np.isfinite(gram).all() and np.isfinite(sums[:4]).all()):
                 # L and S are the last finite iterate; V, Y2 and Lh were
                 # overwritten in place: the state restarts U, V and the duals

@@ -21,9 +21,11 @@ vectorises. In the ``n x m`` layout a row holds a pixel's ``m`` = 30 frames,
 too few for the vector loop to start, and the pass ran scalar
 (docs/solver.md, "Frames-major sweep").
 
-Between passes the weighted SVT stays with BLAS: the Gram matrix ``Lh^T Lh``
-and the product ``U = Lh (left right_t)`` are dense products that a
-hand-written loop does several times slower than sgemm.
+The pass also sums the SVT's Gram matrix ``Lh Lh^T`` block by block, right
+after it writes each block's new ``Lh`` (a BLAS product read ``Lh`` once more,
+on one thread). The product ``U = Lh (left right_t)`` between passes stays
+with BLAS: a dense product that a hand-written loop does several times
+slower than sgemm.
 
 Import side effects, all process-wide and made before the first compiled call:
 
@@ -152,6 +154,37 @@ def _shrink_steps(d, bg, u, lh, s, v, y2, l_new, s_new, t_s, t_v, sums):
     sums[5] += r_v
 
 
+@njit(cache=True, inline='always', fastmath=_FAST)
+def _add_block_gram(rows, lo, hi, gram):
+    """Add the upper triangle of ``rows[:, lo:hi] rows[:, lo:hi]^T`` to ``gram``, four rows a time."""
+    m = rows.shape[0]
+    for a in range(m):
+        first = rows[a, lo:hi]
+        c = a
+        while c < m:
+            # Four products per load of ``first``: the loop is bound by loads.
+            count = min(4, m - c)
+            r0 = rows[c, lo:hi]
+            r1 = rows[c + min(1, count - 1), lo:hi]
+            r2 = rows[c + min(2, count - 1), lo:hi]
+            r3 = rows[c + min(3, count - 1), lo:hi]
+            s0 = s1 = s2 = s3 = np.float32(0.0)
+            for i in range(hi - lo):
+                x = first[i]
+                s0 += x * r0[i]
+                s1 += x * r1[i]
+                s2 += x * r2[i]
+                s3 += x * r3[i]
+            gram[a, c] += s0
+            if count > 1:
+                gram[a, c + 1] += s1
+            if count > 2:
+                gram[a, c + 2] += s2
+            if count > 3:
+                gram[a, c + 3] += s3
+            c += count
+
+
 @njit(parallel=True, cache=True, fastmath=_FAST, nogil=True)
 def primal_pass(data, L, U, Lh, S, V, Y2,
                 s_offsets, s_bands, t_offsets, t_bands, coefficients, l_given,
@@ -175,7 +208,10 @@ def primal_pass(data, L, U, Lh, S, V, Y2,
 
     Returns the float64 sums ``(||L_new - L||^2, ||L||^2, ||S_new - S||^2,
     ||S||^2, ||U - L||^2, ||D - L_new - S_new - V_new||^2)``: the fifth is the
-    previous sweep's primal residual of ``U = L`` (``U`` is that sweep's SVT).
+    previous sweep's primal residual of ``U = L`` (``U`` is that sweep's SVT);
+    and the next SVT's Gram matrix ``Lh Lh^T`` (m x m, float64), each block's
+    part summed right after the block's new ``Lh`` is written
+    (:func:`_add_block_gram`) instead of in a BLAS pass over ``Lh``.
     """
     m, n = data.shape
     coefficients = coefficients.astype(np.float32)
@@ -183,6 +219,7 @@ def primal_pass(data, L, U, Lh, S, V, Y2,
     t_v = coefficients[7]
     n_blocks = (n + _BLOCK_PIXELS - 1) // _BLOCK_PIXELS
     sums = np.zeros((n_blocks, 6), dtype=np.float64)
+    grams = np.zeros((n_blocks, m, m), dtype=np.float64)
     for b in prange(n_blocks):
         lo = b * _BLOCK_PIXELS
         hi = min(n, lo + _BLOCK_PIXELS)
@@ -214,7 +251,12 @@ def primal_pass(data, L, U, Lh, S, V, Y2,
                           V[j, lo:hi], Y2[j, lo:hi], L_new[j, lo:hi], S_new[j, lo:hi],
                           t_s, t_v, block_sums)
         sums[b] = block_sums
-    return sums.sum(axis=0)
+        _add_block_gram(Lh, lo, hi, grams[b])
+    gram = grams.sum(axis=0)
+    for a in range(m):                  # the blocks summed the upper triangle
+        for c in range(a):
+            gram[a, c] = gram[c, a]
+    return sums.sum(axis=0), gram
 
 
 @njit(parallel=True, cache=True, fastmath=_FAST, nogil=True)
