@@ -156,7 +156,7 @@ def _shrink_steps(d, bg, u, lh, s, v, y2, l_new, s_new, t_s, t_v, sums):
 
 @njit(cache=True, inline='always', fastmath=_FAST)
 def _add_block_gram(rows, lo, hi, gram):
-    """Add the upper triangle of ``rows[:, lo:hi] rows[:, lo:hi]^T`` to ``gram``, four rows a time."""
+    """Add the upper triangle of ``rows[:, lo:hi] rows[:, lo:hi]^T`` to ``gram``, 4 at a time."""
     m = rows.shape[0]
     for a in range(m):
         first = rows[a, lo:hi]
