@@ -133,18 +133,23 @@ def test_refit_normal_equations_match_their_definition(r):
     rng = np.random.default_rng(10 + r)
     m, n = 17, 2500                                   # more than one block of pixels
     frames = rng.random((m, 3, n), dtype=np.float32)
-    weights = (rng.random((m, n)) > 0.2).astype(np.float32)
-    temporal = np.linalg.qr(rng.normal(size=(m, r)))[0].astype(np.float32)
-    gram, rhs = normal_equations(frames, 1, weights, temporal)
-    data = frames[:, 1].astype(np.float64)
-    expected_gram = np.einsum('ji,ja,jb->abi', weights, temporal, temporal)
-    expected_rhs = np.einsum('ji,ji,ja->ai', weights, data, temporal)
-    assert gram.shape == (r, r, n) and rhs.shape == (r, n)
-    assert np.allclose(gram, expected_gram, rtol=1e-5, atol=1e-5)
-    assert np.allclose(rhs, expected_rhs, rtol=1e-5, atol=1e-5)
+    held_out = (rng.random((m, n)) < 0.2) * rng.random((m, n)).astype(np.float32)
+    weights = (held_out == 0).astype(np.float64)
+    # Each channel its own factors, of different ranks (a channel's SVD may keep fewer).
+    temporals = [np.linalg.qr(rng.normal(size=(m, max(1, r - c % 2))))[0].astype(np.float32)
+                 for c in range(3)]
+    systems = normal_equations(frames, held_out, temporals)
+    for channel, (temporal, (gram, rhs)) in enumerate(zip(temporals, systems)):
+        data = frames[:, channel].astype(np.float64)
+        expected_gram = np.einsum('ji,ja,jb->abi', weights, temporal, temporal)
+        expected_rhs = np.einsum('ji,ji,ja->ai', weights, data, temporal)
+        k = temporal.shape[1]
+        assert gram.shape == (k, k, n) and rhs.shape == (k, n)
+        assert np.allclose(gram, expected_gram, rtol=1e-5, atol=1e-5)
+        assert np.allclose(rhs, expected_rhs, rtol=1e-5, atol=1e-5)
     # Any memory order of the window gives the same sums.
     strided = np.asfortranarray(frames)
-    assert np.array_equal(normal_equations(strided, 1, weights, temporal)[1], rhs)
+    assert np.array_equal(normal_equations(strided, held_out, temporals)[1][1], systems[1][1])
 
 
 @pytest.mark.parametrize('r', [1, 2, 3])

@@ -7,8 +7,8 @@ The compiled pass of the background refit: each pixel's weighted normal equation
 every full-size pixel's time series on the solve's ``r`` temporal factors
 ``V`` (m x r) with the entries the solve called foreground weighted out.
 Its sums ``G_i = sum_j w_ij v_j v_j^T`` and ``b_i = sum_j w_ij d_ij v_j``
-are one pass over the window here, frame by frame along its contiguous
-rows (the window is frames-major in memory,
+of every channel are one pass over the window here, frame by frame along its
+contiguous rows (the window is frames-major in memory,
 :meth:`~dgmod_ros.core.streaming.results.WindowSnapshot.window`), threaded
 over blocks of pixels; as BLAS products the same sums read the window and
 the weights several times and cost about three times as much.
@@ -27,61 +27,74 @@ _FAST = {'reassoc', 'contract', 'nsz'}
 
 
 @njit(parallel=True, cache=True, nogil=True, fastmath=_FAST)
-def _normal_equations(frames, channel, weights, temporal, gram, rhs):
-    m, _, n = frames.shape
-    r = temporal.shape[1]
+def _normal_equations(frames, held_out, temporal, ranks, gram, rhs):
+    m, channels, n = frames.shape
     block = _BLOCK_PIXELS
     for b in prange((n + block - 1) // block):
         lo = b * block
         hi = min(n, lo + block)
+        w = np.empty(hi - lo, dtype=np.float32)
         weighted = np.empty(hi - lo, dtype=np.float32)
         for j in range(m):
-            w = weights[j, lo:hi]
-            d = frames[j, channel, lo:hi]
+            held = held_out[j, lo:hi]
             for i in range(hi - lo):
-                weighted[i] = w[i] * d[i]
-            for a in range(r):
-                va = temporal[j, a]
-                row = rhs[a, lo:hi]
+                w[i] = np.float32(held[i] == 0)
+            for channel in range(channels):
+                d = frames[j, channel, lo:hi]
                 for i in range(hi - lo):
-                    row[i] += va * weighted[i]
-                for c in range(a, r):
-                    vac = va * temporal[j, c]
-                    row = gram[a, c, lo:hi]
+                    weighted[i] = w[i] * d[i]
+                r = ranks[channel]
+                for a in range(r):
+                    va = temporal[channel, j, a]
+                    row = rhs[channel, a, lo:hi]
                     for i in range(hi - lo):
-                        row[i] += vac * w[i]
+                        row[i] += va * weighted[i]
+                    for c in range(a, r):
+                        vac = va * temporal[channel, j, c]
+                        row = gram[channel, a, c, lo:hi]
+                        for i in range(hi - lo):
+                            row[i] += vac * w[i]
 
 
-def normal_equations(frames, channel, weights, temporal):
+def normal_equations(frames, held_out, temporals):
     """
-    Return each pixel's ``G`` (r, r, n) and ``b`` (r, n) of one channel's weighted fit.
+    Return each channel's ``G`` (r, r, n) and ``b`` (r, n) of the weighted fit, as a list.
+
+    One pass over the window for all channels: each entry's weight (1
+    observed, 0 held out) is read once for every channel.
 
     Parameters
     ----------
     frames : ndarray (m, C, n) float32
         The window frame by frame (C-ordered: no copy for a snapshot's
         stacked columns; any other order is copied).
-    channel : int
-        The channel fitted.
-    weights : ndarray (m, n) float32
-        Each entry's weight (1 observed, 0 held out).
-    temporal : ndarray (m, r) float32
-        The temporal factors ``V``.
+    held_out : ndarray (m, n) float32
+        Non-zero where an entry is held out of the fit.
+    temporals : sequence of C ndarrays (m, r_c) float32
+        Each channel's temporal factors ``V``.
 
     """
     frames = np.ascontiguousarray(frames, dtype=np.float32)
-    weights = np.ascontiguousarray(weights, dtype=np.float32)
-    temporal = np.ascontiguousarray(temporal, dtype=np.float32)
-    r, n = temporal.shape[1], frames.shape[2]
-    gram = np.zeros((r, r, n), dtype=np.float32)
-    rhs = np.zeros((r, n), dtype=np.float32)
-    _normal_equations(frames, int(channel), weights, temporal, gram, rhs)
-    for a in range(r):                  # the pass fills the upper triangle
-        gram[a + 1:, a] = gram[a, a + 1:]
-    return gram, rhs
+    held_out = np.ascontiguousarray(held_out, dtype=np.float32)
+    channels, n = frames.shape[1], frames.shape[2]
+    ranks = np.array([t.shape[1] for t in temporals], dtype=np.int64)
+    r = int(ranks.max())
+    temporal = np.zeros((channels, frames.shape[0], r), dtype=np.float32)
+    for channel, factors in enumerate(temporals):
+        temporal[channel, :, :factors.shape[1]] = factors
+    gram = np.zeros((channels, r, r, n), dtype=np.float32)
+    rhs = np.zeros((channels, r, n), dtype=np.float32)
+    _normal_equations(frames, held_out, temporal, ranks, gram, rhs)
+    systems = []
+    for channel, rank in enumerate(ranks):
+        channel_gram = gram[channel, :rank, :rank]
+        for a in range(rank):               # the pass fills the upper triangle
+            channel_gram[a + 1:, a] = channel_gram[a, a + 1:]
+        systems.append((channel_gram, rhs[channel, :rank]))
+    return systems
 
 
 def compile_kernel():
     """Compile (or load from the cache) the pass on a tiny input."""
-    normal_equations(np.ones((4, 3, 5), dtype=np.float32), 0, np.ones((4, 5), dtype=np.float32),
-                     np.ones((4, 2), dtype=np.float32))
+    normal_equations(np.ones((4, 3, 5), dtype=np.float32), np.zeros((4, 5), dtype=np.float32),
+                     [np.ones((4, 2), dtype=np.float32)] * 3)

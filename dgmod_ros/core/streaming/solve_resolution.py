@@ -354,17 +354,16 @@ def carry_backgrounds(data, shape, backgrounds, small_residuals, small_shape, ra
     magnitude = np.abs(small_residuals).max(axis=0)                       # (n_small, m)
     noise = pixel_noise(small_residuals, small_shape)
     held_out = (magnitude.T > _HELD_OUT_SIGMAS * noise[None, :]).astype(np.float32)
-    held_out = resample_frames(held_out, small_shape, shape, cv2.INTER_LINEAR)
-    weights = (held_out == 0).astype(np.float32)                          # (m, n)
+    held_out = resample_frames(held_out, small_shape, shape, cv2.INTER_LINEAR)  # (m, n)
     ridge = np.float32(0.1 / data.shape[2])
     frames = data.transpose(2, 0, 1)                                      # (m, C, n)
+    temporals = [thin_svd(small, int(rank))[2] for small in backgrounds]  # (m, r) each
+    # Systems as columns (r, r, n) and (r, n): the elimination's rows are contiguous.
+    systems = normal_equations(frames, held_out, temporals)
     factors = []
-    for channel, small in enumerate(backgrounds):
-        _, _, temporal = thin_svd(small, int(rank))                       # (m, r)
+    for small, temporal, (gram, rhs) in zip(backgrounds, temporals, systems):
         r = temporal.shape[1]
         start = resample_columns(small @ temporal, small_shape, shape, cv2.INTER_LINEAR)
-        # Systems as columns (r, r, n) and (r, n): the elimination's rows are contiguous.
-        gram, rhs = normal_equations(frames, channel, weights, temporal)
         gram[np.arange(r), np.arange(r)] += ridge
         rhs += ridge * start.T
         coef = np.ascontiguousarray(solve_spd(gram, rhs).T)               # (n, r)
