@@ -478,22 +478,20 @@ class DualGraphMOD:
     # ------------------------------------------------------------------ public
     def build_operators(self, data, frame_shape):
         """
-        Graph Laplacians, the temporal eigenbasis and the data's Gram matrix for one window.
+        Graph Laplacians (the temporal eigenbasis on demand) and the data's Gram matrix.
 
         ``phi_s_bands`` and ``phi_t_bands`` hold the Laplacians' diagonal bands
-        (what the fused sweep applies); ``phi_t`` is dense (m x m), and the
-        sparse ``phi_s`` of the numpy steps is formed from its bands on first
-        use only.
+        (what the fused sweep applies); ``phi_t`` is dense (m x m). The sparse
+        ``phi_s`` of the numpy steps and ``Phi_t``'s eigenbasis (the exact
+        L-step) are formed on first use only (:class:`_Operators`).
         """
         offsets, bands, self.h_s_ = spatial_laplacian_bands(
             data, frame_shape, self.patch_size, self.h_s, self.smoothing_sigma)
         gram = gram_matrix(data)
         phi_t, self.h_t_ = temporal_laplacian(data, self.temporal_neighbors, self.h_t, gram)
-        mu, basis = np.linalg.eigh(phi_t)
-        phi_t = phi_t.astype(np.float32)
-        return _Operators(phi_s_bands=(offsets, bands), phi_t=phi_t,
-                          phi_t_bands=diagonal_bands(phi_t), basis=basis.astype(np.float32),
-                          mu=mu, data_gram=gram)
+        return _Operators(phi_s_bands=(offsets, bands), phi_t=phi_t.astype(np.float32),
+                          phi_t_bands=diagonal_bands(phi_t.astype(np.float32)),
+                          phi_t_float64=phi_t, data_gram=gram)
 
     def objective(self, data, frame_shape):
         """
@@ -590,13 +588,22 @@ class DualGraphMOD:
 
 
 class _Operators(dict):
-    """A window's operators; the sparse ``phi_s`` is formed from its bands when first read."""
+    """
+    A window's operators; what only some L-steps read is formed when first read.
+
+    The sparse ``phi_s`` (the numpy steps) from its bands, and the
+    eigendecomposition of ``Phi_t`` (``mu`` and ``basis``, the exact L-step).
+    """
 
     def __missing__(self, key):
-        if key != 'phi_s':
+        if key == 'phi_s':
+            self['phi_s'] = banded_matrix(*self['phi_s_bands'])
+        elif key in ('mu', 'basis'):
+            mu, basis = np.linalg.eigh(self['phi_t_float64'])
+            self['mu'], self['basis'] = mu, basis.astype(np.float32)
+        else:
             raise KeyError(key)
-        self['phi_s'] = banded_matrix(*self['phi_s_bands'])
-        return self['phi_s']
+        return self[key]
 
 
 def _ratio(squared_change, squared_norm):
