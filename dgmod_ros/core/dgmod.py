@@ -388,7 +388,8 @@ class DualGraphMOD:
         docstring) and is formed once, at the end. The pass runs on the
         frames-major transposes of the iterates (:func:`kernels.frames_major`);
         the iterates handed back are ``n x m`` views of them (F-ordered), so a
-        warm start from them needs no transpose.
+        warm start from them needs no transpose. The given L, S, U and Y1
+        are read, never written: the caller's state needs no copy.
         """
         from . import kernels       # numba compiles or loads its cache on first use
         # Again at every solve: an OpenBLAS loaded since (scipy.linalg's) must
@@ -396,7 +397,11 @@ class DualGraphMOD:
         limit_blas_threads(1)
 
         D = kernels.frames_major(data)
-        L, S, U, V, Y2 = (kernels.frames_major(iterates[k]) for k in ('L', 'S', 'U', 'V', 'Y2'))
+        # L, S and U are read only (the given ones may be the caller's
+        # state); V and Y2 are updated in place, so the pass gets copies.
+        L, S, U = (kernels.frames_major(iterates[k]) for k in ('L', 'S', 'U'))
+        V, Y2 = (kernels.frames_major(iterates[k]).copy() for k in ('V', 'Y2'))
+        given = {id(L), id(S), id(U)}
         Lh = U - kernels.frames_major(iterates['Y1'])   # so that U - Lh is the given Y1
         weights, sigma = iterates['weights'], iterates['sigma']
         rho1, rho2 = float(self.rho1), float(self.rho2)
@@ -446,7 +451,7 @@ class DualGraphMOD:
                 # overwritten in place: the state restarts U, V and the duals
                 # (U = L, V = Y1 = Y2 = 0) instead of handing them over.
                 self.info_ = -1
-                U[...] = L
+                U = L.copy()
                 Lh[...] = L
                 V[...] = 0.0
                 Y2[...] = 0.0
@@ -460,6 +465,10 @@ class DualGraphMOD:
             weights = np.exp(-(sigma / self.weight_scale_) ** 2).astype(np.float32)
             L, L_new = L_new, L
             S, S_new = S_new, S
+            if id(L_new) in given:      # the given L and S: the next sweep writes new ones
+                L_new, S_new = np.empty_like(D), np.empty_like(D)
+            if id(U) in given:
+                U = np.empty_like(D)
             # U^T = (left right_t)^T Lh^T, frames-major: through the k x n factor
             # left^T Lh^T when the SVT keeps k < m / 2 components (2 k m n
             # multiply-adds against m^2 n; the background keeps a few of m).
@@ -553,24 +562,28 @@ class DualGraphMOD:
             # runs in one memory order (kernels.frames_major).
             from . import kernels
             data = kernels.frames_major(data).T
+        fused = self.engine == 'fused' and self.svd == 'gram'
         state = self._initial_state(data) if init is None else replace(init)
-        # Copies in the state's own memory order: the fused solver's state is
-        # frames-major, and a copy into C order would be a strided transpose.
-        L = state.background.copy(order='K')
+        # The numpy steps update every iterate in place, so they start from
+        # copies, in the state's own memory order (a copy of the fused
+        # solver's frames-major state into C order would be a strided
+        # transpose); the fused sweep copies what it updates in place itself.
+        own = (lambda array: array) if fused else (lambda array: array.copy(order='K'))
+        L = own(state.background)
         # A warm start's new columns know nothing of the new frames: putting
         # the whole residual into S satisfies D = L + S + V exactly.
         if init is not None:
             S = np.subtract(data, L, out=np.empty_like(L))
             S -= state.noise
         else:
-            S = state.foreground.copy(order='K')
-        U, V = state.low_rank.copy(order='K'), state.noise.copy(order='K')
-        Y1, Y2 = state.dual_low_rank.copy(order='K'), state.dual_noise.copy(order='K')
+            S = own(state.foreground)
+        U, V = own(state.low_rank), own(state.noise)
+        Y1, Y2 = own(state.dual_low_rank), own(state.dual_noise)
         iterates = {'L': L, 'S': S, 'U': U, 'V': V, 'Y1': Y1, 'Y2': Y2,
                     'weights': state.weights, 'sigma': np.zeros(m)}
         history = {k: [] for k in ('change_L', 'change_S', 'residual_U', 'residual_V', 'rank')}
         self.info_ = self.max_iter
-        if self.engine == 'fused' and self.svd == 'gram':
+        if fused:
             self._run_fused(data, ops, iterates, history, data_norm)
         else:
             self._run_numpy(data, ops, iterates, history, data_norm)
