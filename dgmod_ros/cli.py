@@ -28,7 +28,7 @@ import cv2
 
 from . import config
 from .core.preprocess import to_uint8
-from .core.runtime import keep_freed_memory
+from .core.runtime import keep_freed_memory, yield_to_compute
 from .evaluation import evaluate
 from .inputs import BadInput, count_frames, read_frames
 from .sequence import results
@@ -179,6 +179,7 @@ def read_ahead(iterable, depth=_READ_AHEAD):
     end = object()
 
     def produce():
+        yield_to_compute()
         try:
             for item in iterable:
                 while not stop.is_set():
@@ -212,7 +213,8 @@ class PngWriter:
     """Write PNG files in a thread, at most ``_WRITES_PENDING`` waiting; errors raised here."""
 
     def __init__(self):
-        self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix='dgmod-write')
+        self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix='dgmod-write',
+                                        initializer=yield_to_compute)
         self._pending = deque()
 
     def write(self, path, image):

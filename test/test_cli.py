@@ -3,11 +3,15 @@
 """The offline command end to end on small inputs the tests write."""
 
 import json
+import os
+import sys
+import threading
 
 from bags import write_image_bag
 import cv2
 from dgmod_ros import cli
 from dgmod_ros.core.metrics import iou
+from dgmod_ros.core.runtime import IO_THREAD_NICENESS
 from dgmod_ros.core.synthetic import synthetic_scene
 import numpy as np
 import pytest
@@ -152,3 +156,26 @@ def test_existing_output_is_not_overwritten_without_force(tmp_path, scene, capsy
     out.mkdir()
     assert run('separate', folder, '--out', out) == 2
     assert 'exists' in capsys.readouterr().err
+
+
+@pytest.mark.skipif(not sys.platform.startswith('linux'), reason='per-thread nice values: Linux')
+def test_file_threads_yield_to_the_separation(tmp_path, monkeypatch):
+    # The reader and the writer run at a lower priority than the thread that
+    # separates, which keeps its own (core/runtime.yield_to_compute).
+    def priority():
+        return os.getpriority(os.PRIO_PROCESS, threading.get_native_id())
+    main = priority()
+    lowered = min(main + IO_THREAD_NICENESS, 19)
+    produced, written = [], []
+
+    def frames():
+        for index in range(3):
+            produced.append(priority())
+            yield index
+    assert list(cli.read_ahead(frames())) == [0, 1, 2]
+    monkeypatch.setattr(cli, '_write_png', lambda path, image: written.append(priority()))
+    writer = cli.PngWriter()
+    writer.write(tmp_path / 'mask.png', np.zeros((2, 2), dtype=np.uint8))
+    writer.close()
+    assert produced == [lowered] * 3 and written == [lowered]
+    assert priority() == main

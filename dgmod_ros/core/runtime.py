@@ -4,7 +4,9 @@
 
 import ctypes
 import ctypes.util
+import os
 import sys
+import threading
 
 _M_TRIM_THRESHOLD = -1
 _M_MMAP_THRESHOLD = -3
@@ -42,6 +44,35 @@ def keep_freed_memory():
     ok = mallopt(_M_TRIM_THRESHOLD, 1024 * 1024 * 1024) == 1 and ok
     _applied = ok
     return ok
+
+
+# Nice increment of a helper thread that decodes or encodes files: the same
+# weight against the separation's threads as a process at nice 10 (about a
+# tenth of the CPU when both want it).
+IO_THREAD_NICENESS = 10
+
+
+def yield_to_compute(increment=IO_THREAD_NICENESS):
+    """
+    Lower the calling thread's scheduling priority by ``increment`` (Linux only).
+
+    ``dgmod separate`` decodes frames and encodes masks in helper threads
+    with queues of slack. On two cores the window solve is the critical
+    path, and every time slice a helper takes from it delays the stream
+    (docs/node.md, "Stream rate"); with this, the helpers run when the
+    separation's threads wait. On Linux the nice value is a per-thread
+    attribute, so only the caller changes; elsewhere it would be the whole
+    process, so nothing is done. Returns True where the priority changed.
+    """
+    if not sys.platform.startswith('linux') or not hasattr(os, 'setpriority'):
+        return False
+    thread = threading.get_native_id()
+    try:
+        os.setpriority(os.PRIO_PROCESS, thread, os.getpriority(os.PRIO_PROCESS, thread)
+                       + int(increment))
+    except OSError:
+        return False
+    return True
 
 
 _OPENBLAS_SETTERS = ('openblas_set_num_threads', 'openblas_set_num_threads64_',
