@@ -382,14 +382,17 @@ class DualGraphMOD:
         Sweep with the compiled pass of :mod:`dgmod_ros.core.kernels`.
 
         The same steps as :meth:`_run_numpy` in the same order, the same
-        iterates and the same stopping sweep; the primal pass also sums the
-        Gram matrix of the next ``Lh = L - Y1``, and BLAS forms the SVT as the
-        rank-k product ``U = (Lh left) right_t``. ``Y1`` lives as ``U - Lh`` (kernels module
-        docstring) and is formed once, at the end. The pass runs on the
-        frames-major transposes of the iterates (:func:`kernels.frames_major`);
-        the iterates handed back are ``n x m`` views of them (F-ordered), so a
-        warm start from them needs no transpose. The given L, S, U and Y1
-        are read, never written: the caller's state needs no copy.
+        iterates and the same stopping sweep. The primal pass also sums the
+        Gram matrix of the next ``Lh = L - Y1``, and forms the last SVT's
+        ``U = (Lh left) right_t`` block by block from its rank-k factors; BLAS
+        forms the whole product only where ``U`` itself is read (the stopping
+        test, a numpy L-step, the state handed back). ``Y1`` lives as
+        ``U - Lh`` (kernels module docstring) and is formed once, at the end.
+        The pass runs on the frames-major transposes of the iterates
+        (:func:`kernels.frames_major`); the iterates handed back are ``n x m``
+        views of them (F-ordered), so a warm start from them needs no
+        transpose. The given L, S, U and Y1 are read, never written: the
+        caller's state needs no copy.
         """
         from . import kernels       # numba compiles or loads its cache on first use
         # Again at every solve: an OpenBLAS loaded since (scipy.linalg's) must
@@ -401,8 +404,20 @@ class DualGraphMOD:
         # state); V and Y2 are updated in place, so the pass gets copies.
         L, S, U = (kernels.frames_major(iterates[k]) for k in ('L', 'S', 'U'))
         V, Y2 = (kernels.frames_major(iterates[k]).copy() for k in ('V', 'Y2'))
-        given = {id(L), id(S), id(U)}
+        given = {id(L), id(S)}
         Lh = U - kernels.frames_major(iterates['Y1'])   # so that U - Lh is the given Y1
+        # After a sweep's SVT, U = (left right_t)^T Lh is kept as its factors:
+        # the next pass forms it block by block (kernels.primal_pass), and the
+        # n x m product is formed only where U itself is read.
+        svt = None                  # (left^T, right_t^T) float32, or None: U is formed
+        m = data.shape[1]
+        no_svt = (np.zeros((0, m), np.float32), np.zeros((m, 0), np.float32))
+
+        def formed_u():
+            # U^T = (left right_t)^T Lh^T, frames-major, through the k x n factor.
+            left_t, right = svt
+            return np.matmul(right, left_t @ Lh)
+
         weights, sigma = iterates['weights'], iterates['sigma']
         rho1, rho2 = float(self.rho1), float(self.rho2)
         g1, g2, c = float(self.gamma1), float(self.gamma2), rho1 + rho2
@@ -428,6 +443,9 @@ class DualGraphMOD:
                                 float(np.sqrt(squared_gap)) / data_norm, residual_V, rank)
 
         for _ in range(self.max_iter):
+            if svt is not None and (l_given or (pending is not None
+                                                and max(pending[:3]) < self.tol)):
+                U, svt = formed_u(), None
             if pending is not None and max(pending[:3]) < self.tol:
                 stop = finish(kernels.squared_gap(U, L))
                 pending = None
@@ -441,8 +459,9 @@ class DualGraphMOD:
                 self._l_rhs(data, U.T, Y1.T, S.T, V.T, Y2.T, rhs.T, work.T)
                 np.copyto(L_new.T, self._l_step(rhs.T, L.T, ops, c))
             sums, gram = kernels.primal_pass(
-                D, L, U, Lh, S, V, Y2, s_offsets, s_bands, t_offsets, t_bands,
-                coefficients, l_given, L_new, S_new)
+                D, L, D if svt is not None else U, Lh, S, V, Y2, s_offsets, s_bands,
+                t_offsets, t_bands, coefficients, l_given, L_new, S_new,
+                *(svt or no_svt), svt is not None)
             if pending is not None:
                 finish(sums[4])     # not below tol: pending's own figures are not
                 pending = None
@@ -451,7 +470,7 @@ class DualGraphMOD:
                 # overwritten in place: the state restarts U, V and the duals
                 # (U = L, V = Y1 = Y2 = 0) instead of handing them over.
                 self.info_ = -1
-                U = L.copy()
+                U, svt = L.copy(), None
                 Lh[...] = L
                 V[...] = 0.0
                 Y2[...] = 0.0
@@ -467,17 +486,14 @@ class DualGraphMOD:
             S, S_new = S_new, S
             if id(L_new) in given:      # the given L and S: the next sweep writes new ones
                 L_new, S_new = np.empty_like(D), np.empty_like(D)
-            if id(U) in given:
-                U = np.empty_like(D)
-            # U^T = (left right_t)^T Lh^T, frames-major: through the k x n factor
-            # left^T Lh^T when the SVT keeps k < m / 2 components (2 k m n
-            # multiply-adds against m^2 n; the background keeps a few of m).
-            if 2 * left.shape[1] < left.shape[0]:
-                np.matmul(right_t.T.astype(np.float32), left.T.astype(np.float32) @ Lh, out=U)
-            else:
-                np.matmul((left @ right_t).T.astype(np.float32), Lh, out=U)
+            # The SVT keeps k components of m (the background a few): U
+            # through its k x n factor, 2 k m n multiply-adds.
+            svt = (np.ascontiguousarray(left.T, dtype=np.float32),
+                   np.ascontiguousarray(right_t.T, dtype=np.float32))
             pending = (_ratio(sums[0], sums[1]), _ratio(sums[2], sums[3]),
                        float(np.sqrt(sums[5])) / data_norm, rank)
+        if svt is not None:
+            U = formed_u()
         if pending is not None and finish(kernels.squared_gap(U, L)):
             self.info_ = 0          # the last sweep's residual, after the loop
         Y1 = np.subtract(U, Lh, out=Lh)

@@ -21,11 +21,14 @@ vectorises. In the ``n x m`` layout a row holds a pixel's ``m`` = 30 frames,
 too few for the vector loop to start, and the pass ran scalar
 (docs/solver.md, "Frames-major sweep").
 
-The pass also sums the SVT's Gram matrix ``Lh Lh^T`` block by block, right
-after it writes each block's new ``Lh`` (a BLAS product read ``Lh`` once more,
-on one thread). The product ``U = Lh (left right_t)`` between passes stays
-with BLAS: a dense product that a hand-written loop does several times
-slower than sgemm.
+The pass also does the SVT's two n x m products on each block while it is in
+cache, on the pass's threads: before updating a block it forms the block's
+``U = Lh (left right_t)`` from the last SVT's rank-k factors (the SVT keeps a
+few of ``m`` components), and after, it adds the block's part of the next
+Gram matrix ``Lh Lh^T``. As BLAS products between passes, on one thread
+(OpenBLAS must not spin beside the kernels), they read ``Lh`` twice more and
+wrote ``U`` for the pass to read back. Only the eigendecomposition of the
+m x m Gram matrix runs between passes.
 
 Import side effects, all process-wide and made before the first compiled call:
 
@@ -188,7 +191,7 @@ def _add_block_gram(rows, lo, hi, gram):
 @njit(parallel=True, cache=True, fastmath=_FAST, nogil=True)
 def primal_pass(data, L, U, Lh, S, V, Y2,
                 s_offsets, s_bands, t_offsets, t_bands, coefficients, l_given,
-                L_new, S_new):
+                L_new, S_new, svt_left, svt_right, u_from_svt):
     """
     Run one sweep but the SVT, fused, threaded over blocks of pixels.
 
@@ -205,6 +208,10 @@ def primal_pass(data, L, U, Lh, S, V, Y2,
     ``coefficients`` = (g1, g2, c, rho1, rho2, step, lam2 / rho2, 1 / rho2).
     ``s_bands[k, i] = Phi_s[i, i + s_offsets[k]]`` and
     ``t_bands[k, j] = Phi_t[j, j + t_offsets[k]]`` (:func:`diagonal_bands`).
+    With ``u_from_svt``, ``U`` is not read: each block forms its own
+    ``U = svt_right (svt_left Lh)`` (``svt_left`` k x m, ``svt_right`` m x k,
+    the last SVT's factors) from its ``Lh`` before updating it, in cache,
+    instead of an n x m product between passes that the pass then reads.
 
     Returns the float64 sums ``(||L_new - L||^2, ||L||^2, ||S_new - S||^2,
     ||S||^2, ||U - L||^2, ||D - L_new - S_new - V_new||^2)``: the fifth is the
@@ -226,7 +233,17 @@ def primal_pass(data, L, U, Lh, S, V, Y2,
         spatial = np.empty(hi - lo, dtype=np.float32)
         temporal = np.empty(hi - lo, dtype=np.float32)
         block_sums = np.zeros(6, dtype=np.float64)
+        rank = svt_left.shape[0] if u_from_svt else 0
+        mixed = np.zeros((rank, hi - lo), dtype=np.float32)         # svt_left Lh
+        block_u = np.zeros((m if u_from_svt else 0, hi - lo), dtype=np.float32)
+        for a in range(rank):
+            for frame in range(m):
+                _add_scaled(svt_left[a, frame], Lh[frame, lo:hi], mixed[a])
+        for frame in range(block_u.shape[0]):
+            for a in range(rank):
+                _add_scaled(svt_right[frame, a], mixed[a], block_u[frame])
         for j in range(m):
+            u = block_u[j] if u_from_svt else U[j, lo:hi]
             if not l_given:
                 spatial[:] = 0.0
                 temporal[:] = 0.0
@@ -244,10 +261,10 @@ def primal_pass(data, L, U, Lh, S, V, Y2,
                     other = j + t_offsets[k]
                     if 0 <= other < m:
                         _add_scaled(t_bands[k, j], L[other, lo:hi], temporal)
-                _gradient_step(data[j, lo:hi], L[j, lo:hi], U[j, lo:hi], Lh[j, lo:hi],
+                _gradient_step(data[j, lo:hi], L[j, lo:hi], u, Lh[j, lo:hi],
                                S[j, lo:hi], V[j, lo:hi], Y2[j, lo:hi], spatial, temporal,
                                L_new[j, lo:hi], coefficients)
-            _shrink_steps(data[j, lo:hi], L[j, lo:hi], U[j, lo:hi], Lh[j, lo:hi], S[j, lo:hi],
+            _shrink_steps(data[j, lo:hi], L[j, lo:hi], u, Lh[j, lo:hi], S[j, lo:hi],
                           V[j, lo:hi], Y2[j, lo:hi], L_new[j, lo:hi], S_new[j, lo:hi],
                           t_s, t_v, block_sums)
         sums[b] = block_sums
