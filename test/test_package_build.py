@@ -85,7 +85,9 @@ def test_installed_detector_masks_frames_and_stops_cleanly(install, monkeypatch,
         node.create_subscription(Image, 'foreground_mask', masks.append, QoSProfile(depth=50))
         publisher = node.create_publisher(Image, 'image', QoSProfile(depth=10))
         frames = synthetic_scene(n_frames=20, shape=(48, 64)).frames
-        deadline = time.monotonic() + 30
+        # A fresh install compiles the kernels when it configures (numba's
+        # cache is per installed file): about 30 s on two cores.
+        deadline = time.monotonic() + 90
         index = 0
         while len(masks) < 3 and time.monotonic() < deadline:
             assert process.poll() is None, process.communicate()[0]

@@ -157,7 +157,22 @@ def _shrink_steps(d, bg, u, lh, s, v, y2, l_new, s_new, t_s, t_v, sums):
     sums[5] += r_v
 
 
-@njit(cache=True, inline='always', fastmath=_FAST)
+# Not inlined, as _add_block_gram below: compiled apart, they keep the
+# parallel pass's compile time (a cold install's first start) near what it
+# was without them.
+@njit(cache=True, nogil=True, fastmath=_FAST)
+def _block_u(rows, lo, hi, svt_left, svt_right, out):
+    """Write ``svt_right (svt_left rows[:, lo:hi])`` (m x block) into ``out``."""
+    mixed = np.zeros((svt_left.shape[0], hi - lo), dtype=np.float32)
+    for a in range(svt_left.shape[0]):
+        for frame in range(rows.shape[0]):
+            _add_scaled(svt_left[a, frame], rows[frame, lo:hi], mixed[a])
+    for frame in range(out.shape[0]):
+        for a in range(svt_left.shape[0]):
+            _add_scaled(svt_right[frame, a], mixed[a], out[frame])
+
+
+@njit(cache=True, nogil=True, fastmath=_FAST)
 def _add_block_gram(rows, lo, hi, gram):
     """Add the upper triangle of ``rows[:, lo:hi] rows[:, lo:hi]^T`` to ``gram``, 4 at a time."""
     m = rows.shape[0]
@@ -233,17 +248,15 @@ def primal_pass(data, L, U, Lh, S, V, Y2,
         spatial = np.empty(hi - lo, dtype=np.float32)
         temporal = np.empty(hi - lo, dtype=np.float32)
         block_sums = np.zeros(6, dtype=np.float64)
-        rank = svt_left.shape[0] if u_from_svt else 0
-        mixed = np.zeros((rank, hi - lo), dtype=np.float32)         # svt_left Lh
-        block_u = np.zeros((m if u_from_svt else 0, hi - lo), dtype=np.float32)
-        for a in range(rank):
-            for frame in range(m):
-                _add_scaled(svt_left[a, frame], Lh[frame, lo:hi], mixed[a])
-        for frame in range(block_u.shape[0]):
-            for a in range(rank):
-                _add_scaled(svt_right[frame, a], mixed[a], block_u[frame])
+        # The block's U, formed from the SVT's factors or copied from U: the
+        # steps below read one kind of row (a contiguous one).
+        block_u = np.zeros((m, hi - lo), dtype=np.float32)
+        if u_from_svt:
+            _block_u(Lh, lo, hi, svt_left, svt_right, block_u)
+        else:
+            block_u[:, :] = U[:, lo:hi]
         for j in range(m):
-            u = block_u[j] if u_from_svt else U[j, lo:hi]
+            u = block_u[j]
             if not l_given:
                 spatial[:] = 0.0
                 temporal[:] = 0.0
