@@ -1,7 +1,8 @@
 # Copyright 2026 dgmod_ros authors
 # Licensed under the Apache License, Version 2.0
-from dgmod_ros.core.graphs import (banded_matrix, normalized_laplacian, spatial_laplacian,
-                                   spatial_laplacian_bands, temporal_laplacian)
+from dgmod_ros.core.graphs import (banded_matrix, diagonal_bands, normalized_laplacian,
+                                   spatial_laplacian, spatial_laplacian_bands,
+                                   temporal_laplacian)
 from dgmod_ros.core.linalg import gram_matrix
 import numpy as np
 import pytest
@@ -173,3 +174,16 @@ def test_spatial_bands_are_the_laplacian_of_the_definition(shape):
         assert np.all(band[~inside] == 0)
         assert np.allclose(band[inside], expected[rows[inside], rows[inside] + offset],
                            atol=1e-6)
+
+
+def test_diagonal_bands_reproduce_the_matrix():
+    rng = np.random.default_rng(3)
+    dense = np.where(rng.random((9, 9)) < 0.3, rng.standard_normal((9, 9)), 0.0)
+    for matrix in (sp.csr_matrix(dense), dense):
+        offsets, bands = diagonal_bands(matrix)
+        rebuilt = np.zeros_like(dense)
+        for k, offset in enumerate(offsets):
+            for i in range(9):
+                if 0 <= i + offset < 9:
+                    rebuilt[i, i + offset] = bands[k, i]
+        assert np.allclose(rebuilt, dense, atol=1e-6)

@@ -19,7 +19,6 @@ from dgmod_ros.core.synthetic import synthetic_scene
 import numba
 import numpy as np
 import pytest
-import scipy.sparse as sp
 
 SHAPE = (36, 48)
 FRAMES = 24
@@ -124,19 +123,6 @@ def test_converged_engines_reach_the_same_objective():
     # Not a vacuous bound: the objective at the median start is 44% higher.
     start = DualGraphMOD(max_iter=1).fit(data, SHAPE)
     assert start.objective(data, SHAPE) > 1.3 * min(values)
-
-
-def test_diagonal_bands_reproduce_the_matrix():
-    rng = np.random.default_rng(3)
-    dense = np.where(rng.random((9, 9)) < 0.3, rng.standard_normal((9, 9)), 0.0)
-    for matrix in (sp.csr_matrix(dense), dense):
-        offsets, bands = kernels.diagonal_bands(matrix)
-        rebuilt = np.zeros_like(dense)
-        for k, offset in enumerate(offsets):
-            for i in range(9):
-                if 0 <= i + offset < 9:
-                    rebuilt[i, i + offset] = bands[k, i]
-        assert np.allclose(rebuilt, dense, atol=1e-6)
 
 
 def test_kernels_run_from_two_threads_at_once():

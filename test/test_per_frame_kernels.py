@@ -194,18 +194,19 @@ def test_bgr_frames_give_the_columns_of_their_channels_reversed(dtype, channels)
         assert shape == expected_shape and np.array_equal(got, expected)
 
 
-@pytest.mark.parametrize('dtype', [np.uint8, np.uint16, np.int16])
+@pytest.mark.parametrize('dtype', [np.uint8, np.uint16])
 @pytest.mark.parametrize('channels, order', [(3, 'rgb'), (3, 'bgr'), (4, 'bgr'), (4, 'rgb')])
 def test_half_size_colour_columns_are_the_general_conversion_bit_for_bit(dtype, channels, order):
-    # frame_columns takes one compiled pass for an integer colour frame at
-    # scale 0.5; the general path (float frame, OpenCV's area resize, columns)
-    # is the reference, value_range clipping and negative values included.
+    # frame_columns takes one compiled pass for an 8- or 16-bit colour frame
+    # at scale 0.5; the general path (float frame, OpenCV's area resize,
+    # columns) is the reference, value_range clipping included, and a padded
+    # image (rows a strided view, as a message with row padding gives) too.
     rng = np.random.default_rng(channels + len(order))
     top = np.iinfo(dtype).max
-    image = rng.integers(np.iinfo(dtype).min, top, (48, 64, channels), endpoint=True,
-                         dtype=dtype)
-    image[0, :4] = top                                  # full scale: exactly 1.0
-    for value_range in (None, 1000.0):
+    padded = rng.integers(0, top, (48, 70, channels), endpoint=True, dtype=dtype)
+    padded[0, :4] = top                                 # full scale: exactly 1.0
+    cases = ((padded[:, :64], None), (np.ascontiguousarray(padded[:, :64]), 1000.0))
+    for image, value_range in cases:
         got, shape = frame_columns(image, 0.5, 'rgb', order, value_range)
         channels_first = to_float_channels(image, order, 'rgb', value_range)
         small = cv2.resize(channels_first, (32, 24), interpolation=cv2.INTER_AREA)

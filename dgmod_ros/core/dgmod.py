@@ -458,7 +458,7 @@ class DualGraphMOD:
                 np.subtract(U, Lh, out=Y1)
                 self._l_rhs(data, U.T, Y1.T, S.T, V.T, Y2.T, rhs.T, work.T)
                 np.copyto(L_new.T, self._l_step(rhs.T, L.T, ops, c))
-            sums, gram = kernels.primal_pass(
+            sums, gram = kernels.primal_pass(     # (U unread with the SVT's factors: D)
                 D, L, D if svt is not None else U, Lh, S, V, Y2, s_offsets, s_bands,
                 t_offsets, t_bands, coefficients, l_given, L_new, S_new,
                 *(svt or no_svt), svt is not None)

@@ -6,12 +6,13 @@ A frame to float columns at half size in one compiled pass (the default robot ca
 :func:`~dgmod_ros.core.preprocess.frame_columns` converts a frame to float32
 in [0, 1] at full size, averages 2 x 2 areas (OpenCV's ``INTER_AREA``) and
 transposes the result into per-channel columns: four passes over a 640 x 480
-frame in the per-frame path. For an integer colour frame of even size at
-``scale`` 0.5, :func:`half_columns` does the same arithmetic in one pass over
-the frame and writes the columns directly: each value scaled and clipped as
-:func:`~dgmod_ros.core.preprocess.to_float_channels` does, and the area
-``(((a + b) + c) + d) * 0.25`` in the order of OpenCV's integer-ratio area
-resize, so the columns are the same bit for bit (``test/test_per_frame_kernels.py``).
+frame in the per-frame path. For an 8- or 16-bit colour frame of even size
+at ``scale`` 0.5, :func:`half_columns` does the same arithmetic in one pass
+over the frame and writes the columns directly: each value scaled and
+clipped as :func:`~dgmod_ros.core.preprocess.to_float_channels` does, and
+the area ``(((a + b) + c) + d) * 0.25`` in the order of OpenCV's
+integer-ratio area resize, so the columns are the same bit for bit
+(``test/test_per_frame_kernels.py``).
 Importing :mod:`dgmod_ros.core.kernels` first makes its process-wide numba
 settings hold here too; the pass is serial and ``nogil`` (the image callback's).
 """
@@ -45,7 +46,7 @@ def _half_columns(image, scale, reverse, out):
 
 def half_columns(image, scale, reverse):
     """
-    Return the (3, n) float32 columns of an integer (h, w, >= 3) frame at half its size.
+    Return the (3, n) float32 columns of a uint8 or uint16 (h, w, >= 3) frame at half its size.
 
     ``scale`` is the float32 factor to [0, 1] (``1 / value_range``);
     ``reverse`` takes the first three channels in reverse order (BGR input).
@@ -53,10 +54,13 @@ def half_columns(image, scale, reverse):
     """
     rows, cols = image.shape[0] // 2, image.shape[1] // 2
     out = np.empty((3, rows * cols), dtype=np.float32)
-    _half_columns(image, np.float32(scale), bool(reverse), out)
+    # C-contiguous, the layout compiled at start-up (a padded image row is a
+    # strided view): another layout would compile in the image callback.
+    _half_columns(np.ascontiguousarray(image), np.float32(scale), bool(reverse), out)
     return out
 
 
 def compile_kernel():
-    """Compile (or load from the cache) the pass on a tiny frame."""
-    half_columns(np.zeros((2, 2, 3), dtype=np.uint8), 1.0 / 255, False)
+    """Compile (or load from the cache) the pass for 8- and 16-bit frames."""
+    for dtype in (np.uint8, np.uint16):
+        half_columns(np.zeros((2, 2, 3), dtype=dtype), 1.0 / np.iinfo(dtype).max, False)

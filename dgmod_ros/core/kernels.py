@@ -66,7 +66,6 @@ import numba  # noqa: E402 (the cache folder must be set before numba reads its 
 from numba import njit, prange  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .graphs import diagonal_bands  # noqa: E402,F401 (the bands the pass applies)
 from .linalg import c_order  # noqa: E402
 from .runtime import limit_blas_threads  # noqa: E402
 
@@ -222,7 +221,8 @@ def primal_pass(data, L, U, Lh, S, V, Y2,
     solver falls back on both when an iterate is not finite).
     ``coefficients`` = (g1, g2, c, rho1, rho2, step, lam2 / rho2, 1 / rho2).
     ``s_bands[k, i] = Phi_s[i, i + s_offsets[k]]`` and
-    ``t_bands[k, j] = Phi_t[j, j + t_offsets[k]]`` (:func:`diagonal_bands`).
+    ``t_bands[k, j] = Phi_t[j, j + t_offsets[k]]``
+    (:func:`~dgmod_ros.core.graphs.diagonal_bands`).
     With ``u_from_svt``, ``U`` is not read: each block forms its own
     ``U = svt_right (svt_left Lh)`` (``svt_left`` k x m, ``svt_right`` m x k,
     the last SVT's factors) from its ``Lh`` before updating it, in cache,

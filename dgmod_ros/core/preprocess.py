@@ -111,7 +111,7 @@ def frame_columns(frame, scale, color='gray', channel_order='rgb', value_range=N
         raise ValueError(f'frame must be a non-empty image, got shape {frame.shape}')
     rows, cols = processing_shape(frame.shape[:2], scale)
     if (color == 'rgb' and frame.ndim == 3 and frame.shape[2] in (3, 4)
-            and frame.dtype.kind in 'ui' and frame.shape[:2] == (2 * rows, 2 * cols)
+            and frame.dtype in (np.uint8, np.uint16) and frame.shape[:2] == (2 * rows, 2 * cols)
             and channel_order in ('rgb', 'bgr')):
         # A colour camera at scale 0.5: the same columns in one pass (halving_kernel).
         full_scale = unit_scale(frame.dtype) if value_range is None else float(value_range)
