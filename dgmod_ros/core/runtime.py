@@ -59,7 +59,7 @@ def yield_to_compute(increment=IO_THREAD_NICENESS):
     ``dgmod separate`` decodes frames and encodes masks in helper threads
     with queues of slack. On two cores the window solve is the critical
     path, and every time slice a helper takes from it delays the stream
-    (docs/node.md, "Stream rate"); with this, the helpers run when the
+    (docs/node.md, "less memory traffic"); with this, the helpers run when the
     separation's threads wait. On Linux the nice value is a per-thread
     attribute, so only the caller changes; elsewhere it would be the whole
     process, so nothing is done. Returns True where the priority changed.
