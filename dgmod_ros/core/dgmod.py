@@ -404,7 +404,7 @@ class DualGraphMOD:
         # state); V and Y2 are updated in place, so the pass gets copies.
         L, S, U = (kernels.frames_major(iterates[k]) for k in ('L', 'S', 'U'))
         V, Y2 = (kernels.frames_major(iterates[k]).copy() for k in ('V', 'Y2'))
-        given = {id(L), id(S)}
+        given_L = L                 # the first sweep swaps it, and the given S, out
         Lh = U - kernels.frames_major(iterates['Y1'])   # so that U - Lh is the given Y1
         # After a sweep's SVT, U = (left right_t)^T Lh is kept as its factors:
         # the next pass forms it block by block (kernels.primal_pass), and the
@@ -484,7 +484,7 @@ class DualGraphMOD:
             weights = np.exp(-(sigma / self.weight_scale_) ** 2).astype(np.float32)
             L, L_new = L_new, L
             S, S_new = S_new, S
-            if id(L_new) in given:      # the given L and S: the next sweep writes new ones
+            if L_new is given_L:        # the given L and S: the next sweep writes new ones
                 L_new, S_new = np.empty_like(D), np.empty_like(D)
             # The SVT keeps k components of m (the background a few): U
             # through its k x n factor, 2 k m n multiply-adds.
@@ -572,13 +572,13 @@ class DualGraphMOD:
         else:
             self.weight_scale_ = float(self.weight_scale)
 
-        if self.engine == 'fused' and self.svd == 'gram':
+        fused = self.engine == 'fused' and self.svd == 'gram'
+        if fused:
             # The compiled pass runs frames-major; ``data`` becomes an n x m
             # view of the transpose, so that the state's arithmetic below
             # runs in one memory order (kernels.frames_major).
             from . import kernels
             data = kernels.frames_major(data).T
-        fused = self.engine == 'fused' and self.svd == 'gram'
         state = self._initial_state(data) if init is None else replace(init)
         # The numpy steps update every iterate in place, so they start from
         # copies, in the state's own memory order (a copy of the fused
