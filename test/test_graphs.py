@@ -1,5 +1,6 @@
 # Copyright 2026 dgmod_ros authors
 # Licensed under the Apache License, Version 2.0
+from dgmod_ros.core.graph_kernel import neighbour_square_sums
 from dgmod_ros.core.graphs import (banded_matrix, diagonal_bands, normalized_laplacian,
                                    spatial_laplacian, spatial_laplacian_bands,
                                    temporal_laplacian)
@@ -187,3 +188,26 @@ def test_diagonal_bands_reproduce_the_matrix():
                 if 0 <= i + offset < 9:
                     rebuilt[i, i + offset] = bands[k, i]
         assert np.allclose(rebuilt, dense, atol=1e-6)
+
+
+@pytest.mark.parametrize('shape', [(12, 9), (1, 9), (9, 1), (1, 1)])
+def test_neighbour_square_sums_are_the_frame_sums_in_order(shape):
+    rows, cols = shape
+    frames = np.random.default_rng(7).random((11, rows, cols)).astype(np.float32)
+    right, down = neighbour_square_sums(frames)
+    assert right.shape == (rows, cols - 1) and down.shape == (rows - 1, cols)
+    # float32 sums over the frames in their order, as the einsum of before adds them.
+    across = np.diff(frames, axis=2)
+    along = np.diff(frames, axis=1)
+    expected_right = np.zeros(right.shape, dtype=np.float32)
+    expected_down = np.zeros(down.shape, dtype=np.float32)
+    for k in range(frames.shape[0]):
+        expected_right += across[k] * across[k]
+        expected_down += along[k] * along[k]
+    assert np.array_equal(right, expected_right) and np.array_equal(down, expected_down)
+    # The solver's frames-major window (an F-ordered n x m view) and a C-ordered
+    # copy give the same Laplacian.
+    window = frames.reshape(11, -1).T
+    for a, b in zip(spatial_laplacian_bands(window, shape),
+                    spatial_laplacian_bands(np.ascontiguousarray(window), shape)):
+        assert np.array_equal(a, b)

@@ -61,6 +61,22 @@ def test_fused_sweep_gives_the_numpy_iterates(options):
     assert_same_iterates(numpy_model, fused_model, atol=1e-4)
 
 
+@pytest.mark.parametrize('frames', [1, 2, 5, 7, 12])
+def test_block_gram_and_u_are_the_products_for_any_window_length(frames):
+    # The Gram matrix goes by 3 x 4 tiles, which the window length need not fill.
+    rows = np.random.default_rng(frames).random((frames, 70)).astype(np.float32)
+    gram = np.zeros((frames, frames))
+    kernels._add_block_gram(rows, 5, 66, gram)
+    block = rows[:, 5:66].astype(np.float64)
+    upper = np.triu_indices(frames)
+    assert np.allclose(gram[upper], (block @ block.T)[upper], rtol=1e-5)
+    left = np.random.default_rng(1).random((3, frames)).astype(np.float32)
+    right = np.random.default_rng(2).random((frames, 3)).astype(np.float32)
+    out = kernels._block_u(rows, 5, 66, left, right)
+    assert out.shape == (frames, 61) and out.dtype == np.float32
+    assert np.allclose(out, right @ (left @ block), rtol=1e-5)
+
+
 def test_fused_solve_stops_where_numpy_stops_and_warm_starts_alike():
     data = scene_window()
     first = [DualGraphMOD(engine=e, tol=1e-3).fit(data[:, :-4], SHAPE) for e in ('numpy', 'fused')]

@@ -15,7 +15,7 @@ import numpy as np
 from scipy import ndimage
 import scipy.sparse as sp
 
-from .linalg import gram_matrix
+from .linalg import c_order, gram_matrix
 
 
 def normalized_laplacian(adjacency):
@@ -136,24 +136,20 @@ def spatial_laplacian_bands(data, frame_shape, patch_size=3, h=None, smoothing_s
     n1, n2 = frame_shape
     m = data.shape[1]
     n = n1 * n2
-    cube = np.asarray(data, dtype=np.float32).reshape(n1, n2, m)
+    # Frames-major (m, n1, n2): free for the fused solver's window, whose
+    # memory is already in that order (kernels.frames_major).
+    frames = c_order(np.asarray(data, dtype=np.float32).T).reshape(m, n1, n2)
     if smoothing_sigma > 0:
-        cube = ndimage.gaussian_filter(cube, sigma=(smoothing_sigma, smoothing_sigma, 0),
-                                       mode='reflect')
+        frames = ndimage.gaussian_filter(frames, sigma=(0, smoothing_sigma, smoothing_sigma),
+                                         mode='reflect')
     # (axis, offset in row-major order) of the right and the lower neighbour.
-    directions = [(axis, step) for axis, step in ((1, 1), (0, n2)) if cube.shape[axis] >= 2]
+    directions = [(axis, step) for axis, step in ((1, 1), (0, n2)) if (n1, n2)[axis] >= 2]
     if not directions:
         return (np.zeros(1, dtype=np.int64), np.zeros((1, n), dtype=np.float32),
                 1.0 if h is None else float(h))
-    dists = []
-    for axis, _ in directions:
-        lead = [slice(None)] * 2
-        lag = [slice(None)] * 2
-        lead[axis] = slice(1, None)
-        lag[axis] = slice(None, -1)
-        diff = cube[tuple(lead)] - cube[tuple(lag)]
-        pixel_sq = np.einsum('ijk,ijk->ij', diff, diff)
-        dists.append(_box_sum(pixel_sq, patch_size))
+    from .graph_kernel import neighbour_square_sums     # numba: imported on first use
+    sums = dict(zip((1, 0), neighbour_square_sums(frames)))
+    dists = [_box_sum(sums[axis], patch_size) for axis, _ in directions]
     weights, h_used = _gaussian_weights(
         np.concatenate([d.ravel() for d in dists]).astype(np.float64), h)
     weights = weights.astype(np.float32)

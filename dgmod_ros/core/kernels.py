@@ -28,7 +28,11 @@ few of ``m`` components), and after, it adds the block's part of the next
 Gram matrix ``Lh Lh^T``. As BLAS products between passes, on one thread
 (OpenBLAS must not spin beside the kernels), they read ``Lh`` twice more and
 wrote ``U`` for the pass to read back. Only the eigendecomposition of the
-m x m Gram matrix runs between passes.
+m x m Gram matrix runs between passes. Within a block, ``U``'s two small
+products are BLAS calls (single-threaded, below: each kernel thread makes
+its own) and the Gram matrix is summed by register tiles: the sweep of the
+converged solve is bound by its arithmetic, not by memory (docs/solver.md,
+"Where a converged sweep's time goes").
 
 Import side effects, all process-wide and made before the first compiled call:
 
@@ -159,46 +163,65 @@ def _shrink_steps(d, bg, u, lh, s, v, y2, l_new, s_new, t_s, t_v, sums):
 # Not inlined, as _add_block_gram below: compiled apart, they keep the
 # parallel pass's compile time (a cold install's first start) near what it
 # was without them.
-@njit(cache=True, nogil=True, fastmath=_FAST)
-def _block_u(rows, lo, hi, svt_left, svt_right, out):
-    """Write ``svt_right (svt_left rows[:, lo:hi])`` (m x block) into ``out``."""
-    mixed = np.zeros((svt_left.shape[0], hi - lo), dtype=np.float32)
-    for a in range(svt_left.shape[0]):
-        for frame in range(rows.shape[0]):
-            _add_scaled(svt_left[a, frame], rows[frame, lo:hi], mixed[a])
-    for frame in range(out.shape[0]):
-        for a in range(svt_left.shape[0]):
-            _add_scaled(svt_right[frame, a], mixed[a], out[frame])
+@njit(cache=True, nogil=True)
+def _block_u(rows, lo, hi, svt_left, svt_right):
+    """Return ``svt_right (svt_left rows[:, lo:hi])`` (m x block)."""
+    # Two small matrix products: BLAS (one thread, kernels module docstring)
+    # runs them at twice the rate of a compiled loop here.
+    return np.dot(svt_right, np.dot(svt_left, np.ascontiguousarray(rows[:, lo:hi])))
+
+
+@njit(cache=True, inline='always')
+def _add_tile(gram, a, c, count, sums):
+    """Add the tile ``sums`` (3 rows of 4) to ``gram[a:a + 3, c:c + count]`` inside ``gram``."""
+    for r in range(3):
+        if a + r < gram.shape[0]:
+            for k in range(count):
+                gram[a + r, c + k] += sums[4 * r + k]
 
 
 @njit(cache=True, nogil=True, fastmath=_FAST)
 def _add_block_gram(rows, lo, hi, gram):
-    """Add the upper triangle of ``rows[:, lo:hi] rows[:, lo:hi]^T`` to ``gram``, 4 at a time."""
+    """
+    Add the upper triangle of ``rows[:, lo:hi] rows[:, lo:hi]^T`` to ``gram``, by 3 x 4 tiles.
+
+    Twelve products per seven loads: the loop is bound by loads, and twelve
+    accumulators and seven values still fit the vector registers. A tile
+    that reaches below the diagonal adds there too; the caller keeps the
+    upper triangle only.
+    """
     m = rows.shape[0]
-    for a in range(m):
-        first = rows[a, lo:hi]
+    for a in range(0, m, 3):
+        x0 = rows[a, lo:hi]
+        x1 = rows[min(a + 1, m - 1), lo:hi]
+        x2 = rows[min(a + 2, m - 1), lo:hi]
         c = a
         while c < m:
-            # Four products per load of ``first``: the loop is bound by loads.
             count = min(4, m - c)
             r0 = rows[c, lo:hi]
             r1 = rows[c + min(1, count - 1), lo:hi]
             r2 = rows[c + min(2, count - 1), lo:hi]
             r3 = rows[c + min(3, count - 1), lo:hi]
-            s0 = s1 = s2 = s3 = np.float32(0.0)
+            s00 = s01 = s02 = s03 = np.float32(0.0)
+            s10 = s11 = s12 = s13 = np.float32(0.0)
+            s20 = s21 = s22 = s23 = np.float32(0.0)
             for i in range(hi - lo):
-                x = first[i]
-                s0 += x * r0[i]
-                s1 += x * r1[i]
-                s2 += x * r2[i]
-                s3 += x * r3[i]
-            gram[a, c] += s0
-            if count > 1:
-                gram[a, c + 1] += s1
-            if count > 2:
-                gram[a, c + 2] += s2
-            if count > 3:
-                gram[a, c + 3] += s3
+                p, q, w = x0[i], x1[i], x2[i]
+                u0, u1, u2, u3 = r0[i], r1[i], r2[i], r3[i]
+                s00 += p * u0
+                s01 += p * u1
+                s02 += p * u2
+                s03 += p * u3
+                s10 += q * u0
+                s11 += q * u1
+                s12 += q * u2
+                s13 += q * u3
+                s20 += w * u0
+                s21 += w * u1
+                s22 += w * u2
+                s23 += w * u3
+            _add_tile(gram, a, c, count,
+                      (s00, s01, s02, s03, s10, s11, s12, s13, s20, s21, s22, s23))
             c += count
 
 
@@ -250,11 +273,10 @@ def primal_pass(data, L, U, Lh, S, V, Y2,
         block_sums = np.zeros(6, dtype=np.float64)
         # The block's U, formed from the SVT's factors or copied from U: the
         # steps below read one kind of row (a contiguous one).
-        block_u = np.zeros((m, hi - lo), dtype=np.float32)
         if u_from_svt:
-            _block_u(Lh, lo, hi, svt_left, svt_right, block_u)
+            block_u = _block_u(Lh, lo, hi, svt_left, svt_right)
         else:
-            block_u[:, :] = U[:, lo:hi]
+            block_u = np.ascontiguousarray(U[:, lo:hi])
         for j in range(m):
             u = block_u[j]
             if not l_given:

@@ -96,8 +96,18 @@ def pixel_noise(residual, shape, observed=None, uniform=False, sample=None):
         and upsampled to ``shape`` before the smoothing; None: at every pixel.
 
     """
+    return magnitude_noise(np.abs(residual).max(axis=0), shape, observed, uniform, sample)
+
+
+def magnitude_noise(magnitude, shape, observed=None, uniform=False, sample=None):
+    """
+    Return :func:`pixel_noise` from the magnitude of the residual (n, m).
+
+    ``magnitude`` is ``|D - L|``, largest over the channels, for a caller
+    that has it already, or a non-negative statistic of its own (the
+    chromaticity distance); the other parameters are :func:`pixel_noise`'s.
+    """
     rows, cols = shape[:2]
-    magnitude = np.abs(residual).max(axis=0)                     # (n, m)
     median, count = observed_median(magnitude, observed)
     if observed is not None:
         doubtful = count < magnitude.shape[1] / 2

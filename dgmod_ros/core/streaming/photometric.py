@@ -37,7 +37,7 @@ Workshop, 1999.
 
 import numpy as np
 
-from .foreground import pixel_noise
+from .foreground import magnitude_noise
 from .texture import descriptor_distance, RELATIVE_THRESHOLD
 
 # Smallest squared background norm: a black pixel has no chromaticity.
@@ -93,7 +93,7 @@ def chroma_noise(data, residual, shape, observed=None, uniform=False, sample=Non
     chroma = window_chroma(data, residual)
     if chroma is None:
         _, chroma = distortion(data, data - residual)
-    return pixel_noise(chroma[None], shape, observed, uniform, sample)
+    return magnitude_noise(chroma, shape, observed, uniform, sample)   # a distance: >= 0
 
 
 class LightingTest:

@@ -23,7 +23,7 @@ import numpy as np
 
 from .carry_kernel import normal_equations
 from .fast_path import background_basis
-from .foreground import pixel_noise
+from .foreground import magnitude_noise
 from ..linalg import thin_svd
 
 # Most channels one cv2.resize call takes: OpenCV 5's CV_CN_MAX, and 4 for
@@ -352,7 +352,7 @@ def carry_backgrounds(data, shape, backgrounds, small_residuals, small_shape, ra
     # Frames-major throughout (:meth:`~.results.WindowSnapshot.window`): a
     # frame's pixels are one contiguous row of ``data[c].T`` and of the weights.
     magnitude = np.abs(small_residuals).max(axis=0)                       # (n_small, m)
-    noise = pixel_noise(small_residuals, small_shape)
+    noise = magnitude_noise(magnitude, small_shape)
     held_out = (magnitude.T > _HELD_OUT_SIGMAS * noise[None, :]).astype(np.float32)
     held_out = resample_frames(held_out, small_shape, shape, cv2.INTER_LINEAR)  # (m, n)
     ridge = np.float32(0.1 / data.shape[2])
