@@ -227,9 +227,23 @@ def test_window_chroma_kernel_gives_numpy_distortion(seed):
 
 
 @pytest.mark.parametrize('columns', [29, 30])
-def test_median_of_fully_observed_rows_is_numpys(columns):
+@pytest.mark.parametrize('order', ['C', 'F'])
+def test_median_of_fully_observed_rows_is_numpys(columns, order):
     magnitude = np.abs(np.random.default_rng(columns).normal(0, 0.02, (400, columns)))
-    magnitude = magnitude.astype(np.float32)
+    magnitude = magnitude.astype(np.float32, order=order)   # F: the carry's residual
     median, count = observed_median(magnitude)
     assert median.dtype == np.float32 and np.array_equal(median, np.median(magnitude, axis=1))
     assert np.all(count == columns)
+
+
+@pytest.mark.parametrize('columns', [1, 5, 30])
+def test_median_of_observed_entries_is_the_lower_median_of_numpys_filled_sort(columns):
+    rng = np.random.default_rng(columns)
+    magnitude = rng.random((300, columns), dtype=np.float32)
+    observed = rng.random((300, columns)) < 0.7
+    observed[:3] = False                                  # rows with no entry observed
+    median, count = observed_median(magnitude, observed)
+    ordered = np.sort(np.where(observed, magnitude, np.inf), axis=1)
+    expected_count = np.count_nonzero(observed, axis=1)
+    assert np.array_equal(count, expected_count)
+    assert np.array_equal(median, ordered[np.arange(300), np.maximum(expected_count - 1, 0) // 2])

@@ -9,7 +9,7 @@ import numpy as np
 from .graphs import (banded_matrix, diagonal_bands, spatial_laplacian_bands,
                      temporal_laplacian)
 from .linalg import (drop_oldest, gram_eigh, gram_matrix, mixing_factors, relative_change,
-                     shrink, singular_value_map, top_singular_value)
+                     row_median, shrink, singular_value_map, top_singular_value)
 from .runtime import limit_blas_threads
 from .window_data import check_window_data
 
@@ -231,7 +231,7 @@ class DualGraphMOD:
 
     # ------------------------------------------------------------------ steps
     def _initial_state(self, data):
-        median = np.median(data, axis=1, keepdims=True).astype(np.float32)
+        median = row_median(data)[:, None]
         background = np.empty_like(data)        # in the memory order of data
         background[...] = median
         zeros = np.zeros_like(data)

@@ -377,5 +377,7 @@ def compile_all():
     compile_blobs()                                       # the ghost and still tests
     from .streaming.lighting_kernel import compile_kernel as compile_lighting
     compile_lighting()                                    # the lighting test
+    from .streaming.noise_kernel import compile_kernel as compile_noise
+    compile_noise()                                       # the solve's noise levels
     from .streaming.carry_kernel import compile_kernel as compile_carry
     compile_carry()                                       # the background refit

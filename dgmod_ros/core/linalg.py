@@ -122,6 +122,22 @@ def c_order(matrix):
     return np.ascontiguousarray(matrix)
 
 
+def row_median(matrix):
+    """
+    Return numpy's median of each row (n,) of a float32 matrix (even rows: the middle two's mean).
+
+    From a sort of a C-ordered copy: ``np.median`` along the rows of the
+    fused solver's frames-major window (an F-ordered view, so each row is
+    strided) took 35 ms against 6 ms at 30,000 x 60. The entries must be
+    finite (a window is checked on the way in), where the two agree.
+    """
+    ordered = np.sort(c_order(matrix), axis=1)
+    half = ordered.shape[1] // 2
+    if ordered.shape[1] % 2:
+        return ordered[:, half]
+    return (ordered[:, half - 1] + ordered[:, half]) / np.float32(2)
+
+
 def relative_change(new, old):
     """Return ``||new - old||_F / ||old||_F`` (an all-zero ``old`` gives inf, or 0 if equal)."""
     denom = np.linalg.norm(old)

@@ -38,6 +38,7 @@ import numpy as np
 from .blobs import BlobMotion
 from .coherence import mean_field_mask
 from .texture import descriptor_distance, RELATIVE_THRESHOLD
+from ..linalg import row_median
 from ..masks import robust_sigma
 
 #: Observations a pixel needs for its own noise level.
@@ -57,21 +58,17 @@ def observed_median(magnitude, observed=None):
     Return each row's median (n,) over its observed entries, and their count (n,).
 
     With ``observed`` None, numpy's median of the whole row (the mean of the
-    middle two for an even count), taken from a sort: ``np.median`` along the
+    middle two for an even count), taken from a sort
+    (:func:`~dgmod_ros.core.linalg.row_median`): ``np.median`` along the
     short rows of an (n, m) array is about 4x slower. Otherwise the lower
-    median of the observed entries. The magnitudes are finite (a solve's
-    residual), so sorting and ``np.median`` agree.
+    median of the observed entries. The magnitudes are float32 and finite (a
+    solve's residual), so sorting and ``np.median`` agree.
     """
     if observed is None:
-        ordered = np.sort(magnitude, axis=1)
-        columns = magnitude.shape[1]
-        half = columns // 2
-        median = (ordered[:, half] if columns % 2
-                  else (ordered[:, half - 1] + ordered[:, half]) / np.float32(2))
-        return median, np.full(magnitude.shape[0], columns)
-    # Unobserved entries sort last.
-    ordered = np.sort(np.where(observed, magnitude, np.inf), axis=1)
-    count = np.count_nonzero(observed, axis=1)
+        return row_median(magnitude), np.full(magnitude.shape[0], magnitude.shape[1])
+    from .noise_kernel import observed_rows     # numba: loaded on first use
+    filled, count = observed_rows(magnitude, observed)
+    ordered = np.sort(filled, axis=1)           # unobserved entries (inf) last
     return ordered[np.arange(ordered.shape[0]), np.maximum(count - 1, 0) // 2], count
 
 

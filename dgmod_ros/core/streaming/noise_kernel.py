@@ -1,0 +1,53 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""
+The observed entries of a window's residual, ready for their per-pixel median, in one pass.
+
+:func:`~dgmod_ros.core.streaming.foreground.observed_median` sorts each
+pixel's row with the unobserved entries set to infinity, so that they sort
+last, and counts the observed ones. In numpy those are ``np.where`` and
+``np.count_nonzero`` along the rows, two passes that took about 1.5 ms for
+a solve's 19,200 x 30 window, more than the sort itself.
+:func:`observed_rows` writes the filled rows and the counts in one pass,
+with the same values. It is serial and ``nogil``.
+"""
+
+from numba import njit
+import numpy as np
+
+# numba's cache folder and threading layer, set before the decorator below runs.
+from .. import kernels  # noqa: F401
+
+
+@njit(cache=True, nogil=True)
+def _observed_rows(magnitude, observed, filled, count):
+    infinity = np.float32(np.inf)
+    for i in range(magnitude.shape[0]):
+        seen = 0
+        for j in range(magnitude.shape[1]):
+            if observed[i, j]:
+                filled[i, j] = magnitude[i, j]
+                seen += 1
+            else:
+                filled[i, j] = infinity
+        count[i] = seen
+
+
+def observed_rows(magnitude, observed):
+    """
+    Return ``np.where(observed, magnitude, inf)`` (n, m) and each row's observed count (n,).
+
+    ``magnitude`` is float32 and ``observed`` bool, both (n, m); the rows
+    come back C-ordered, as the sort along them wants.
+    """
+    magnitude = np.ascontiguousarray(magnitude, dtype=np.float32)
+    observed = np.ascontiguousarray(observed, dtype=np.bool_)
+    filled = np.empty(magnitude.shape, dtype=np.float32)
+    count = np.empty(magnitude.shape[0], dtype=np.int64)
+    _observed_rows(magnitude, observed, filled, count)
+    return filled, count
+
+
+def compile_kernel():
+    """Compile (or load from the cache) the pass on a tiny input."""
+    observed_rows(np.ones((2, 3), dtype=np.float32), np.ones((2, 3), dtype=np.bool_))
