@@ -13,7 +13,7 @@ import types
 
 from dgmod_ros.core import kernels
 from dgmod_ros.core.dgmod import DualGraphMOD
-from dgmod_ros.core.linalg import c_order
+from dgmod_ros.core.linalg import c_order, gram_matrix
 from dgmod_ros.core.runtime import limit_blas_threads
 from dgmod_ros.core.synthetic import synthetic_scene
 import numba
@@ -70,6 +70,12 @@ def test_block_gram_and_u_are_the_products_for_any_window_length(frames):
     block = rows[:, 5:66].astype(np.float64)
     upper = np.triu_indices(frames)
     assert np.allclose(gram[upper], (block @ block.T)[upper], rtol=1e-5)
+    # The whole window's, symmetric, as linalg.gram_matrix takes it from a
+    # frames-major window (and from BLAS for any other).
+    whole = rows.astype(np.float64) @ rows.T.astype(np.float64)
+    for window in (rows.T, np.ascontiguousarray(rows.T)):
+        assert np.allclose(gram_matrix(window), whole, rtol=1e-5)
+    assert np.array_equal(gram_matrix(rows.T), gram_matrix(rows.T).T)
     left = np.random.default_rng(1).random((3, frames)).astype(np.float32)
     right = np.random.default_rng(2).random((frames, 3)).astype(np.float32)
     out = kernels._block_u(rows, 5, 66, left, right)

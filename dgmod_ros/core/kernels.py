@@ -304,11 +304,35 @@ def primal_pass(data, L, U, Lh, S, V, Y2,
                           t_s, t_v, block_sums)
         sums[b] = block_sums
         _add_block_gram(Lh, lo, hi, grams[b])
+    return sums.sum(axis=0), _symmetric_sum(grams)
+
+
+@njit(cache=True, nogil=True)
+def _symmetric_sum(grams):
+    """Return the sum of the blocks' upper triangles (blocks, m, m), made symmetric."""
     gram = grams.sum(axis=0)
-    for a in range(m):                  # the blocks summed the upper triangle
+    for a in range(gram.shape[0]):
         for c in range(a):
             gram[a, c] = gram[c, a]
-    return sums.sum(axis=0), gram
+    return gram
+
+
+@njit(parallel=True, cache=True, nogil=True)
+def frames_gram(rows):
+    """
+    Return ``rows rows^T`` (m x m, float64) of a C-contiguous float32 ``rows`` (m, n).
+
+    The Gram matrix of a frames-major window, by the pass's blocks and tiles
+    (:func:`_add_block_gram`), threaded: at 30 x 19,200 on one thread about
+    three times as fast as BLAS's float32 product, and summed in float64
+    across the blocks.
+    """
+    m, n = rows.shape
+    n_blocks = (n + _BLOCK_PIXELS - 1) // _BLOCK_PIXELS
+    grams = np.zeros((n_blocks, m, m), dtype=np.float64)
+    for b in prange(n_blocks):
+        _add_block_gram(rows, b * _BLOCK_PIXELS, min(n, (b + 1) * _BLOCK_PIXELS), grams[b])
+    return _symmetric_sum(grams)
 
 
 @njit(parallel=True, cache=True, fastmath=_FAST, nogil=True)

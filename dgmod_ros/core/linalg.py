@@ -20,7 +20,18 @@ def shrink(x, threshold, out=None):
 
 
 def gram_matrix(matrix):
-    """Return ``matrix.T @ matrix`` in float64, from the product in the matrix's own type."""
+    """
+    Return ``matrix.T @ matrix`` in float64, from the product in the matrix's own type.
+
+    A float32 matrix whose transpose is C-contiguous (the fused solver's
+    frames-major windows and states) goes to the compiled
+    :func:`~dgmod_ros.core.kernels.frames_gram`, faster on one thread than
+    BLAS here; anything else to BLAS.
+    """
+    rows = matrix.T
+    if matrix.ndim == 2 and matrix.dtype == np.float32 and rows.flags.c_contiguous:
+        from .kernels import frames_gram        # numba: imported on first use
+        return frames_gram(rows)
     return (matrix.T @ matrix).astype(np.float64)
 
 
