@@ -147,9 +147,12 @@ def test_refit_normal_equations_match_their_definition(r):
         assert gram.shape == (k, k, n) and rhs.shape == (k, n)
         assert np.allclose(gram, expected_gram, rtol=1e-5, atol=1e-5)
         assert np.allclose(rhs, expected_rhs, rtol=1e-5, atol=1e-5)
-    # Any memory order of the window gives the same sums.
+    # Any memory order of the window, and its frames as separate columns (a
+    # snapshot's buffer), give the same sums.
     strided = np.asfortranarray(frames)
     assert np.array_equal(normal_equations(strided, held_out, temporals)[1][1], systems[1][1])
+    columns = [frame.copy() for frame in frames]
+    assert np.array_equal(normal_equations(columns, held_out, temporals)[1][1], systems[1][1])
 
 
 @pytest.mark.parametrize('r', [1, 2, 3])
@@ -244,8 +247,8 @@ def test_carried_factors_give_the_backgrounds_columns_and_residuals():
     _, data = _low_rank_window()
     small = downsample_window(data, FULL, HALF)
     half = DualGraphMOD(tol=1e-4, max_iter=200).fit(small[0], HALF[:2])
-    carry = carry_backgrounds(data, FULL, [half.background_], small - half.background_[None],
-                              HALF, 2)
+    carry = carry_backgrounds(data.transpose(2, 0, 1), FULL, [half.background_],
+                              small - half.background_[None], HALF, 2)
     coef, temporal = carry.factors[0]
     background = coef @ temporal.T                                       # (n, m)
     assert np.allclose(carry.newest()[:, 0], background[:, -1], atol=1e-6)

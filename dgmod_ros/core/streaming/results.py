@@ -124,6 +124,17 @@ class WindowSnapshot:
             self.data = np.stack(self.data, axis=0).transpose(1, 2, 0)
         return self.data
 
+    def frames(self):
+        """Return the window frame by frame, each (C, n): the buffered columns, stacked or not."""
+        if isinstance(self.data, np.ndarray):
+            return self.data.transpose(2, 0, 1)
+        return self.data
+
+    @property
+    def width(self):
+        """Return how many frames the window holds (stacking nothing)."""
+        return self.data.shape[2] if isinstance(self.data, np.ndarray) else len(self.data)
+
 
 @dataclass
 class BackgroundModel:

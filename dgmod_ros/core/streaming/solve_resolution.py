@@ -305,7 +305,7 @@ class CarriedBackground:
         return out
 
 
-def carry_backgrounds(data, shape, backgrounds, small_residuals, small_shape, rank):
+def carry_backgrounds(frames, shape, backgrounds, small_residuals, small_shape, rank):
     """
     Return the full-size backgrounds of a window solved at ``small_shape``.
 
@@ -332,9 +332,9 @@ def carry_backgrounds(data, shape, backgrounds, small_residuals, small_shape, ra
 
     Parameters
     ----------
-    data : ndarray (C, n, m) float32
-        The window at full size, best frames-major in memory (each
-        ``data[c].T`` with contiguous rows).
+    frames : sequence of m ndarrays (C, n) float32, or ndarray (m, C, n)
+        The window at full size, frame by frame
+        (:meth:`~.results.WindowSnapshot.frames`).
     shape, small_shape : tuple (rows, cols, ...)
         Full and solve frame sizes.
     backgrounds : list of ndarray (n_small, m)
@@ -349,14 +349,13 @@ def carry_backgrounds(data, shape, backgrounds, small_residuals, small_shape, ra
     CarriedBackground
 
     """
-    # Frames-major throughout (:meth:`~.results.WindowSnapshot.window`): a
-    # frame's pixels are one contiguous row of ``data[c].T`` and of the weights.
+    # Frames-major throughout: a frame's pixels are one contiguous row of
+    # each frame's channels and of the weights.
     magnitude = np.abs(small_residuals).max(axis=0)                       # (n_small, m)
     noise = magnitude_noise(magnitude, small_shape)
     held_out = (magnitude.T > _HELD_OUT_SIGMAS * noise[None, :]).astype(np.float32)
     held_out = resample_frames(held_out, small_shape, shape, cv2.INTER_LINEAR)  # (m, n)
-    ridge = np.float32(0.1 / data.shape[2])
-    frames = data.transpose(2, 0, 1)                                      # (m, C, n)
+    ridge = np.float32(0.1 / len(frames))
     temporals = [thin_svd(small, int(rank))[2] for small in backgrounds]  # (m, r) each
     # Systems as columns (r, r, n) and (r, n): the elimination's rows are contiguous.
     systems = normal_equations(frames, held_out, temporals)

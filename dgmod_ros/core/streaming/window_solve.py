@@ -37,7 +37,7 @@ def warm_starts(snapshot):
         shift = snapshot.first_column - previous.first_column
     else:
         shift = snapshot.first_id - previous.first_id
-    width = snapshot.window().shape[2]
+    width = snapshot.width
     if not 0 <= shift < width or previous.states[0].frames != width:
         return [None] * channels
     return [state.shifted(shift) for state in previous.states]
@@ -101,15 +101,19 @@ def solve_window(snapshot):
         columns = cache = None
     else:
         cache.keep(columns)
-    window = snapshot.window()  # the columns stacked here, in the solve's thread
+    # The columns are stacked (in the solve's thread) only where a step reads
+    # the whole window: with the cache, the solve and its levels do not.
+    window = snapshot.window
     small_shape = _solved_shape(snapshot)
     downscaled = small_shape != tuple(snapshot.shape)
     carried = downscaled or snapshot.refit_background
     started = time.perf_counter()
-    data = window
-    if downscaled:
-        data = (downsample_window(window, snapshot.shape, small_shape) if cache is None
-                else cache.small_window(columns, snapshot.shape, small_shape))
+    if not downscaled:
+        data = window()
+    elif cache is None:
+        data = downsample_window(window(), snapshot.shape, small_shape)
+    else:
+        data = cache.small_window(columns, snapshot.shape, small_shape)
     try:
         separated = separate_channels(snapshot.model, data, small_shape[:2],
                                       warm_starts(snapshot))
@@ -121,7 +125,7 @@ def solve_window(snapshot):
     rank = int(snapshot.basis_rank)
     if carried:
         # Factors only: the full-size backgrounds are never formed whole.
-        carry = carry_backgrounds(window, snapshot.shape, backgrounds, residuals,
+        carry = carry_backgrounds(snapshot.frames(), snapshot.shape, backgrounds, residuals,
                                   small_shape, rank)
         bases, newest, mean = carry.bases(rank), carry.newest(), carry.mean()
     else:
@@ -143,7 +147,7 @@ def solve_window(snapshot):
         if sample is not None and cache is not None:
             sampled = cache.sampled_window(columns, sample)
         else:
-            sampled = _sampled(sample, window)
+            sampled = _sampled(sample, window())
         observed = _sampled(sample, snapshot.observed)
         if carried:
             residuals = carry.residuals(sampled, None if sample is None else sample.pixels)
@@ -155,8 +159,8 @@ def solve_window(snapshot):
         # The global rule's threshold costs a median over the whole window; the
         # per-pixel decisions read ``noise`` instead.
         if carried:
-            residuals = carry.residuals(window)
-        threshold = snapshot.mask_rule.estimate_threshold(residuals, window)
+            residuals = carry.residuals(window())
+        threshold = snapshot.mask_rule.estimate_threshold(residuals, window())
     return BackgroundModel(
         basis=basis, background=newest.reshape(rows, cols, channels),
         mean_background=mean.reshape(rows, cols, channels), threshold=threshold,
