@@ -6,11 +6,12 @@ The spatial graph's squared neighbour differences of a window in one compiled pa
 :func:`~dgmod_ros.core.graphs.spatial_laplacian_bands` weighs each edge of the
 4-neighbour pixel graph by the squared difference of the two pixels summed
 over the window's frames. In numpy that is a difference image per direction
-and an ``einsum`` over the frame axis, whose stride is the window's length:
-about 1.5 ms a direction for 30 frames of 160 x 120, every solve and every
-channel. :func:`neighbour_square_sums` reads each frame once, row by
+and an ``einsum`` over the frame axis, whose stride is the window's length,
+at every solve and for every channel (docs/solver.md has the cost).
+:func:`neighbour_square_sums` reads each frame once, row by
 contiguous row, and adds the frames in their order in float32, as the
-``einsum`` does: the same sums bit for bit (``test/test_graphs.py``).
+``einsum`` did on the fused solver's window: there, the same sums bit for
+bit (``test/test_graphs.py``).
 Importing :mod:`dgmod_ros.core.kernels` first makes its process-wide numba
 settings hold here too; the pass is serial and ``nogil``.
 """

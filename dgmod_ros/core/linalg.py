@@ -139,8 +139,9 @@ def row_median(matrix):
 
     From a sort of a C-ordered copy: ``np.median`` along the rows of the
     fused solver's frames-major window (an F-ordered view, so each row is
-    strided) took 35 ms against 6 ms at 30,000 x 60. The entries must be
-    finite (a window is checked on the way in), where the two agree.
+    strided) took several times as long (docs/solver.md, "Where a converged
+    sweep's time goes"). The entries must be finite (a window is checked on
+    the way in), where the two agree.
     """
     ordered = np.sort(c_order(matrix), axis=1)
     half = ordered.shape[1] // 2

@@ -11,8 +11,8 @@ of every channel are one pass over the window here, frame by frame along its
 contiguous rows, threaded over blocks of pixels; as BLAS products the same
 sums read the window and the weights several times and cost about three
 times as much. The frames are read where they are, a snapshot's buffered
-columns included (:meth:`~dgmod_ros.core.streaming.results.WindowSnapshot.frames`):
-stacking a 640 x 480 window only for this pass took 3.7 ms.
+columns included (:meth:`~dgmod_ros.core.streaming.results.WindowSnapshot.frames`),
+instead of a 640 x 480 window stacked only for this pass.
 Importing :mod:`dgmod_ros.core.kernels` first makes its process-wide numba
 settings (cache folder, ``threadsafe`` threading layer) hold here too.
 """

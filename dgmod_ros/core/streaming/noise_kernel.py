@@ -6,8 +6,8 @@ The observed entries of a window's residual, ready for their per-pixel median, i
 :func:`~dgmod_ros.core.streaming.foreground.observed_median` sorts each
 pixel's row with the unobserved entries set to infinity, so that they sort
 last, and counts the observed ones. In numpy those are ``np.where`` and
-``np.count_nonzero`` along the rows, two passes that took about 1.5 ms for
-a solve's 19,200 x 30 window, more than the sort itself.
+``np.count_nonzero`` along the rows, two passes that together cost more
+than the sort itself (docs/solver.md, "Where a converged sweep's time goes").
 :func:`observed_rows` writes the filled rows and the counts in one pass,
 with the same values. It is serial and ``nogil``.
 """
