@@ -476,8 +476,8 @@ class DualGraphMOD:
                 Y2[...] = 0.0
                 break
             if threshold == 0:      # no nuclear norm (FRPCAG): the prox is the identity
-                left = right_t = np.eye(data.shape[1], dtype=np.float32)
-                sigma, rank = np.zeros(data.shape[1]), data.shape[1]
+                left = right_t = np.eye(m, dtype=np.float32)
+                sigma, rank = np.zeros(m), m
             else:
                 left, right_t, sigma, rank = mixing_factors(gram, lambda values: np.maximum(
                     values - weights[:values.size] * threshold, 0.0))
@@ -514,8 +514,9 @@ class DualGraphMOD:
             data, frame_shape, self.patch_size, self.h_s, self.smoothing_sigma)
         gram = gram_matrix(data)
         phi_t, self.h_t_ = temporal_laplacian(data, self.temporal_neighbors, self.h_t, gram)
-        return _Operators(phi_s_bands=(offsets, bands), phi_t=phi_t.astype(np.float32),
-                          phi_t_bands=diagonal_bands(phi_t.astype(np.float32)),
+        phi_t_float32 = phi_t.astype(np.float32)
+        return _Operators(phi_s_bands=(offsets, bands), phi_t=phi_t_float32,
+                          phi_t_bands=diagonal_bands(phi_t_float32),
                           phi_t_float64=phi_t, data_gram=gram)
 
     def objective(self, data, frame_shape):
