@@ -18,8 +18,10 @@ Printed per receiver: frames masked (% of those the camera published from the
 receiver's first frame to the camera's last), mask latency p50 / p95 (receipt
 to publish), window solves per second, resident memory at the first mask, 5 s
 later (after the first solves) and at the end, and start-up time (process start
-to first mask), with the largest figure sampled during the run and the change
-from 5 s after the first mask to the end (flat memory). The issue asks
+to first mask), with the largest figure sampled during the run, the change
+from 5 s after the first mask to the end, and the largest figure of each half
+of the run after those 5 s (flat memory: a solve's temporaries make single
+readings swing by tens of MB, a leak raises the second peak). The issue asks
 for 60 s runs; ``--seconds`` defaults to 20 for a quick look.
 
 Usage (repo root): PYTHONPATH=. python benchmarks/bench_node.py [--seconds 60]
@@ -147,6 +149,7 @@ def run_receiver(args):
     executor.add_node(node)
     first_mask = rss_first = solves_first = rss_warm = None
     rss_peak, next_sample = 0.0, time.monotonic()
+    rss_after_warm = []     # (time, MB) from the warm mark on, every 0.5 s
     warm_after = min(5.0, args.seconds / 4)
     last_count, last_change = 0, time.monotonic()
     deadline = time.monotonic() + args.seconds + 60.0
@@ -154,7 +157,10 @@ def run_receiver(args):
         executor.spin_once(timeout_sec=0.05)
         figures = statistics()
         if time.monotonic() >= next_sample:
-            rss_peak, next_sample = max(rss_peak, resident_mb()), next_sample + 0.5
+            rss = resident_mb()
+            rss_peak, next_sample = max(rss_peak, rss), next_sample + 0.5
+            if rss_warm is not None:
+                rss_after_warm.append((time.monotonic(), rss))
         if first_mask is None and figures['masks_out'] > 0:
             first_mask = time.time()
             rss_first, solves_first = resident_mb(), figures['solves']
@@ -174,11 +180,26 @@ def run_receiver(args):
         first_mask - args.spawned_at if first_mask is not None else float('nan')),
         'rss_first_mb': rss_first, 'rss_warm_mb': rss_warm, 'rss_end_mb': resident_mb(),
         'rss_peak_mb': max(rss_peak, resident_mb()),
+        **half_peaks(rss_after_warm),
         'solves_per_s': (figures['solves'] - (solves_first or 0)) / span})
     print(json.dumps(figures), flush=True)
     executor.shutdown()
     node.destroy_node()
     rclpy.shutdown()
+
+
+def half_peaks(samples):
+    """
+    Return the largest resident memory of each half of the run after the warm mark.
+
+    A solve's temporaries come and go, so a single reading at the end says
+    little; a leak raises the second half's peak over the first's.
+    """
+    if len(samples) < 2:
+        return {}
+    middle = (samples[0][0] + samples[-1][0]) / 2
+    return {'rss_first_half_peak_mb': max(mb for t, mb in samples if t <= middle),
+            'rss_second_half_peak_mb': max(mb for t, mb in samples if t > middle)}
 
 
 def type_value(text):
@@ -229,7 +250,9 @@ def report(name, camera, figures, rate):
           f"{figures['rss_first_mb']:.0f} MB at first mask, {figures['rss_warm_mb'] or 0:.0f} "
           f"MB 5 s later, {figures['rss_end_mb']:.0f} MB at end ("
           f"{100 * (figures['rss_end_mb'] / (figures['rss_warm_mb'] or float('nan')) - 1):+.1f}%"
-          f"), peak {figures['rss_peak_mb']:.0f} MB; start-up "
+          f"), peak {figures['rss_peak_mb']:.0f} MB, peaks of the halves after 5 s "
+          f"{figures.get('rss_first_half_peak_mb', float('nan')):.0f} / "
+          f"{figures.get('rss_second_half_peak_mb', float('nan')):.0f} MB; start-up "
           f"{figures['startup_s']:.2f} s", flush=True)
 
 

@@ -42,6 +42,7 @@ from . import config
 from .core.kernels import use_threads
 from .core.masks import overlay
 from .core.preprocess import to_float_channels, to_uint8
+from .core.runtime import keep_freed_memory
 from .core.streaming import SolverFailure
 from .depth_outputs import DepthOutputs
 from .image_conversion import (compressed_image_to_array, fill_image, image_to_array,
@@ -125,6 +126,7 @@ class DetectorNode(LifecycleNode):
             self.get_logger().error(f'configure failed: {error}')
             return TransitionCallbackReturn.FAILURE
         config.load_kernels(self._values)      # before the first frame, not in its callback
+        keep_freed_memory()     # the solves' large temporaries reused, not mapped afresh
         with self._lock:
             self._detector = detector
             self._encoding = None

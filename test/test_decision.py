@@ -19,12 +19,12 @@ def test_warmup_noise_reads_the_size_of_the_differences_not_their_spread():
     # An exposure step of 0.05 everywhere plus noise of 0.002: the differences
     # are alike (small spread) but large, and the level must say large.
     second = first + 0.05 + rng.normal(0, 0.002, first.shape).astype(np.float32)
-    level = warmup_noise(np.stack([first, second], axis=2))
+    level = warmup_noise([first, second])
     assert level == pytest.approx(1.4826 * 0.05 / np.sqrt(2), rel=0.1)
 
 
 def test_warmup_noise_of_one_frame_is_the_quantum():
-    assert warmup_noise(np.zeros((3, 10, 1), np.float32)) == pytest.approx(1 / 255)
+    assert warmup_noise([np.zeros((3, 10), np.float32)]) == pytest.approx(1 / 255)
 
 
 def _two_blobs():

@@ -237,6 +237,52 @@ def test_threading_layer_survives_numba_imported_first(tmp_path):
     assert done.stdout.strip() == 'threadsafe'
 
 
+# Run in a fresh interpreter: compile_all, then the detector on read-only
+# frames (a frame viewing a message's bytes is read-only) in several
+# configurations; print every kernel specialisation compiled after compile_all.
+_LATE_COMPILES = """
+import sys
+from numba.core.registry import CPUDispatcher
+from dgmod_ros import config
+from dgmod_ros.core.kernels import compile_all
+from dgmod_ros.core.synthetic import synthetic_scene
+import numpy as np
+
+def specialisations():
+    return {(name, attr): set(map(str, obj.signatures))
+            for name, module in list(sys.modules.items()) if name.startswith('dgmod_ros')
+            for attr, obj in vars(module).items() if isinstance(obj, CPUDispatcher)}
+
+compile_all()
+warm = specialisations()
+scene = synthetic_scene(n_frames=40, shape=(120, 160), seed=1)
+depth = (scene.frames.mean(axis=3) * 20).astype(np.uint16)       # a 16-bit one-channel camera
+cases = [({}, scene.frames, 'rgb', None), ({}, scene.frames[..., ::-1], 'bgr', None),
+         ({'scale': 1.0}, scene.frames, 'rgb', None),
+         ({'color': 'gray'}, depth, 'rgb', 5100.0)]
+for overrides, frames, order, value_range in cases:
+    detector = config.build_detector(dict(config.DEFAULTS, **overrides))
+    for frame in list(frames) * 2:
+        frame = np.array(frame)
+        frame.setflags(write=False)
+        detector.process(frame, order, value_range)
+for key, signatures in specialisations().items():
+    for signature in sorted(signatures - warm.get(key, set())):
+        print(*key, signature)
+"""
+
+
+def test_compile_all_covers_every_kernel_the_detector_calls():
+    # A kernel compiled (or loaded from the cache) on its first call holds the
+    # GIL for 50-250 ms: in the node that stalls the image callback and loses
+    # frames. compile_all, called at configure, must leave none to the first frames.
+    done = subprocess.run([sys.executable, '-c', _LATE_COMPILES], capture_output=True,
+                          text=True, cwd=str(Path(__file__).resolve().parents[1]),
+                          timeout=600)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout == '', f'compiled after compile_all:\n{done.stdout}'
+
+
 def test_frames_major_and_c_order_are_transposes_without_needless_copies():
     matrix = scene_window()
     frames = kernels.frames_major(matrix)

@@ -4,11 +4,12 @@
 
 import cv2
 from dgmod_ros.core.preprocess import frame_columns, to_float_channels
-from dgmod_ros.core.streaming import lighting_kernel, mean_field_kernel
+from dgmod_ros.core.streaming import lighting_kernel, mean_field_kernel, warmup_kernel
 from dgmod_ros.core.streaming.blobs import BlobMotion, moving_share_reference
 from dgmod_ros.core.streaming.coherence import mean_field_mask, mean_field_mask_reference
 from dgmod_ros.core.streaming.foreground import (_edge_strength, ghost_blobs, ghost_labels,
-                                                 observed_median, to_input_size)
+                                                 observed_median, to_input_size,
+                                                 warmup_noise)
 from dgmod_ros.core.streaming.held_foreground import still_blob_pixels
 from dgmod_ros.core.streaming.lighting_kernel import explained_pixels
 from dgmod_ros.core.streaming.photometric import distortion, LightingTest
@@ -247,3 +248,30 @@ def test_median_of_observed_entries_is_the_lower_median_of_numpys_filled_sort(co
     expected_count = np.count_nonzero(observed, axis=1)
     assert np.array_equal(count, expected_count)
     assert np.array_equal(median, ordered[np.arange(300), np.maximum(expected_count - 1, 0) // 2])
+
+
+@pytest.mark.parametrize('count', [1, 2, 3, 4, 5, 8])
+@pytest.mark.parametrize('channels', [1, 3])
+def test_warmup_kernels_give_numpys_medians_and_differences(count, channels):
+    rng = np.random.default_rng(count * 10 + channels)
+    # Quantised values (ties, as 8-bit frames give) and a NaN in some entries.
+    frames = [(rng.integers(0, 6, (channels, 300)) / 5).astype(np.float32)
+              for _ in range(count)]
+    frames[-1][0, 7] = np.nan
+    frames[0][channels - 1, 11] = np.nan
+    stack = np.stack(frames, axis=2)
+    np.testing.assert_array_equal(warmup_kernel.entry_medians(frames),
+                                  np.median(stack, axis=2))
+    differences = warmup_kernel.difference_magnitudes(frames)
+    assert differences.shape == (count - 1, 300)
+    np.testing.assert_array_equal(differences, np.abs(np.diff(stack, axis=-1)).max(axis=0).T)
+
+
+def test_warmup_noise_is_a_python_float_that_the_compiled_field_takes():
+    rng = np.random.default_rng(1)
+    frames = [rng.uniform(0, 1, (3, 64)).astype(np.float32) for _ in range(3)]
+    level = warmup_noise(frames)
+    assert type(level) is float
+    distance = rng.uniform(0, 0.3, 64).astype(np.float32)
+    assert mean_field_kernel.mean_field_spins(distance, level, 6.0, 2.0, 8, 8, 5, 2, 3.0,
+                                              50.0) is not None

@@ -61,6 +61,14 @@ def half_columns(image, scale, reverse):
 
 
 def compile_kernel():
-    """Compile (or load from the cache) the pass for 8- and 16-bit frames."""
+    """
+    Compile (or load from the cache) the pass for 8- and 16-bit frames.
+
+    Writeable and read-only frames both (a frame viewing a message's bytes
+    is read-only), since numba compiles each apart.
+    """
     for dtype in (np.uint8, np.uint16):
-        half_columns(np.zeros((2, 2, 3), dtype=dtype), 1.0 / np.iinfo(dtype).max, False)
+        for writeable in (True, False):
+            frame = np.zeros((2, 2, 3), dtype=dtype)
+            frame.setflags(write=writeable)
+            half_columns(frame, 1.0 / np.iinfo(dtype).max, False)

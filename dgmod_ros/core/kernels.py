@@ -387,6 +387,7 @@ def compile_all():
     data = np.linspace(0.0, 1.0, 12 * 4, dtype=np.float32).reshape(12, 4)
     DualGraphMOD(max_iter=1).fit(data, (3, 4))
     DualGraphMOD(max_iter=1, l_step='exact').fit(data, (3, 4))
+    frames_gram(frames_major(data))     # the Gram matrix of a frames-major window
     from .halving_kernel import compile_kernel as compile_halving
     compile_halving()                                     # a frame to columns at scale 0.5
     from .streaming.irls_kernel import compile_kernel     # the fast path's projection
@@ -401,3 +402,7 @@ def compile_all():
     compile_noise()                                       # the solve's noise levels
     from .streaming.carry_kernel import compile_kernel as compile_carry
     compile_carry()                                       # the background refit
+    from .streaming.texture import compile_kernel as compile_texture
+    compile_texture()                                     # the moving-texture test
+    from .streaming.warmup_kernel import compile_kernel as compile_warmup
+    compile_warmup()                                      # the masks before the first solve

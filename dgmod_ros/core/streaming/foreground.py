@@ -32,12 +32,15 @@ than an opening) and brought to the input size by bilinear interpolation of
 the 0/255 mask, thresholded at half.
 """
 
+import math
+
 import cv2
 import numpy as np
 
 from .blobs import BlobMotion
 from .coherence import mean_field_mask
 from .texture import descriptor_distance, RELATIVE_THRESHOLD
+from .warmup_kernel import difference_magnitudes
 from ..linalg import row_median
 from ..masks import robust_sigma
 
@@ -126,23 +129,27 @@ def magnitude_noise(magnitude, shape, observed=None, uniform=False, sample=None)
     return smooth.ravel()
 
 
-def warmup_noise(buffered):
+def warmup_noise(frames):
     """
     Return one noise level for every pixel before the first solve, from frame differences.
 
-    The level is read like :func:`pixel_noise` reads the residual: 1.4826
-    times the median magnitude (largest over the channels) of the
-    differences of consecutive buffered frames, over all pixels, divided by
+    ``frames`` are the buffered frames and the frame itself, each (C, n),
+    oldest first. The level is read like :func:`pixel_noise` reads the
+    residual: 1.4826 times the median magnitude (largest over the channels)
+    of the differences of consecutive frames, over all pixels, divided by
     sqrt(2) (a difference holds the noise of two frames). The magnitudes are
     not centred on their median first: their spread around their median
     says how alike they are, not how large, and a frame-wide change of a few
     grey levels (an exposure step between the first frames) then gave a
-    level near 0 and a mask full of specks.
+    level near 0 and a mask full of specks. A Python float, as every level
+    the decision takes as one number: the decision then computes in
+    float32, as with each pixel's own levels.
     """
-    if buffered.shape[-1] < 2:
+    if len(frames) < 2:
         return _QUANTUM
-    differences = np.abs(np.diff(buffered, axis=-1)).max(axis=0)
-    return max(_MAD_TO_SIGMA * float(np.median(differences)) / np.sqrt(2.0), _QUANTUM)
+    differences = difference_magnitudes(frames)
+    median = float(np.median(differences, overwrite_input=True))    # a temporary
+    return max(_MAD_TO_SIGMA * median / math.sqrt(2.0), _QUANTUM)
 
 
 def moving_texture_k(columns, background, earlier, noise, k, weak_k, min_bits, shape,

@@ -225,12 +225,15 @@ def mean_field_spins(distance, noise, k, beta, rows, cols, sweeps, radius, z_cap
     unary_quiet = np.empty(shape[0], dtype=np.bool_)
     # The neighbours of a spin -1 among -1 spins, as the reference's float32 subtraction.
     quiet_neighbours = np.float32(-side * side) - np.float32(-1.0)
-    z_caps = np.broadcast_to(np.float32(z_cap) * k, distance.shape).reshape(shape)
-    k_squared = np.broadcast_to(k * k, distance.shape).reshape(shape)
+    # Written into new arrays, not broadcast: a broadcast view is read-only,
+    # and numba compiles a read-only argument apart, in the image callback.
+    z_caps = np.empty(shape, dtype=np.float32)
+    np.multiply(np.float32(z_cap), k, out=z_caps.reshape(-1))
+    k_squared = np.empty(shape, dtype=np.float32)
+    np.multiply(k, k, out=k_squared.reshape(-1))
     _unary(np.ascontiguousarray(distance).reshape(shape),
-           np.ascontiguousarray(noise).reshape(shape), np.ascontiguousarray(z_caps),
-           np.ascontiguousarray(k_squared), beta32, cap, quiet_neighbours, unary, spin,
-           unary_quiet, quiet)
+           np.ascontiguousarray(noise).reshape(shape), z_caps, k_squared, beta32, cap,
+           quiet_neighbours, unary, spin, unary_quiet, quiet)
     new_spin = np.empty_like(spin)
     new_quiet = np.empty_like(quiet)
     row_sums = np.empty(shape, dtype=np.float64)

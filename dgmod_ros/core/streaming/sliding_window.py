@@ -24,6 +24,7 @@ from .photometric import LightingTest
 from .results import FrameResult, WindowSnapshot
 from .settings import assign_validated, check_window_parameters
 from .solve_resolution import ColumnCache, solve_shape
+from .warmup_kernel import entry_medians
 from .window_solve import solve_window
 from ..dgmod import DualGraphMOD
 from ..masks import MaskRule
@@ -361,15 +362,16 @@ class SlidingWindowDetector(StreamingDetector):
         """Return the frame's background (C, n) and its noise level (n,) or mask threshold."""
         model = self.background_model_
         if model is None:
-            # Warm-up: the per-pixel median of what is buffered is the background.
-            buffered = self.buffer_.stack(columns)
-            background = np.median(buffered, axis=2)
+            # Warm-up: the per-pixel median of what is buffered is the background
+            # (the frame itself while nothing is).
+            buffered = self.buffer_.columns()
+            background = entry_medians(buffered or (columns,))
             if self.decision == 'global':
                 residual = columns - background
-                return background, self.mask_rule_.estimate_threshold(residual, buffered)
+                return background, self.mask_rule_.estimate_threshold(
+                    residual, self.buffer_.stack(columns))
             # The frame itself counts: with one frame buffered there is no other difference.
-            with_frame = np.concatenate((buffered, columns[:, :, None]), axis=2)
-            return background, warmup_noise(with_frame)
+            return background, warmup_noise(buffered + (columns,))
         background = robust_projection(model.basis, columns, fit_basis=model.fit_basis)
         if self.decision == 'global':
             if model.threshold is None:     # solved for a per-pixel decision (switched since)

@@ -117,3 +117,9 @@ def descriptor_distance(frame, background, threshold, pixels):
              rows, cols, np.ascontiguousarray(threshold, dtype=np.float32), pixels, OFFSETS,
              window_offsets(cols), out)
     return out
+
+
+def compile_kernel():
+    """Compile (or load from the cache) the distance's kernel on a tiny input."""
+    frame = np.zeros((3, 5, 5), dtype=np.float32)
+    descriptor_distance(frame, frame, np.zeros((3, 1), dtype=np.float32), np.array([12]))
