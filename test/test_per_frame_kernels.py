@@ -250,7 +250,7 @@ def test_median_of_observed_entries_is_the_lower_median_of_numpys_filled_sort(co
     assert np.array_equal(median, ordered[np.arange(300), np.maximum(expected_count - 1, 0) // 2])
 
 
-@pytest.mark.parametrize('count', [1, 2, 3, 4, 5, 8])
+@pytest.mark.parametrize('count', [1, 2, 3, 4, 5, 8, warmup_kernel.NETWORK_FRAMES + 1])
 @pytest.mark.parametrize('channels', [1, 3])
 def test_warmup_kernels_give_numpys_medians_and_differences(count, channels):
     rng = np.random.default_rng(count * 10 + channels)

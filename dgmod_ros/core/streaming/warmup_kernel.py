@@ -12,9 +12,12 @@ stack the buffered frames, take ``np.median`` along the short frame axis
 (a partition per entry) and ``np.diff`` of the stack with the frame: at
 640 x 480 x 3 that was 150-180 ms a frame, in the image callback, which lost
 the frames that came meanwhile. Here the frames are read where they are (a
-typed list), each entry's few values are sorted in registers, and the
-difference magnitudes are written without temporaries. Serial and ``nogil``:
-they run in the image callback beside the solve thread's kernels.
+typed list), each entry's few values are sorted by a network of
+compare-exchanges over whole rows of a block (up to :data:`NETWORK_FRAMES`
+frames; numpy beyond, where the network's square growth costs more than the
+partitions), and the difference magnitudes are written without temporaries.
+Serial and ``nogil``: they run in the image callback beside the solve
+thread's kernels.
 
 Importing :mod:`dgmod_ros.core.kernels` first makes its process-wide numba
 settings (cache folder, ``threadsafe`` threading layer) hold here too.
@@ -28,6 +31,9 @@ import numpy as np
 from .. import kernels  # noqa: F401
 
 
+#: Most frames whose per-entry median the compiled network takes (the
+#: default warm-up has at most 5; ``min_frames`` may ask for up to 300).
+NETWORK_FRAMES = 16
 # Entries a block of the median's sorting network holds per frame (one row of
 # scratch each, in cache).
 _BLOCK = 1024
@@ -104,6 +110,8 @@ def entry_medians(frames):
     count gives the mean of the middle two in float32, and an entry with a
     NaN in any frame gives NaN, as numpy does.
     """
+    if len(frames) > NETWORK_FRAMES:
+        return np.median(np.stack(frames, axis=2), axis=2)
     frames = _typed(frames)
     out = np.empty(frames[0].shape, dtype=np.float32)
     _entry_medians(frames, out)
