@@ -68,6 +68,7 @@ os.environ.setdefault('NUMBA_THREADING_LAYER', 'threadsafe')
 
 import numba  # noqa: E402 (the cache folder must be set before numba reads its config)
 from numba import njit, prange  # noqa: E402
+from numba.typed import List  # noqa: E402
 import numpy as np  # noqa: E402
 
 from .linalg import c_order  # noqa: E402
@@ -373,6 +374,17 @@ def frames_major(matrix):
     transpose (:func:`~dgmod_ros.core.linalg.c_order`).
     """
     return c_order(np.asarray(matrix, dtype=np.float32).T)
+
+
+def typed_frames(frames):
+    """
+    Return a sequence of frames (each (C, n)) as a numba typed list of C-ordered float32 arrays.
+
+    A kernel that reads the frames where they are takes one compiled type
+    whatever their count (a window's buffered columns, without a stack);
+    each frame is copied only where it is not C-ordered float32 already.
+    """
+    return List([np.ascontiguousarray(frame, dtype=np.float32) for frame in frames])
 
 
 def compile_all():

@@ -18,12 +18,11 @@ settings (cache folder, ``threadsafe`` threading layer) hold here too.
 """
 
 from numba import njit, prange
-from numba.typed import List
 import numpy as np
 
 # numba's cache folder and threading layer, set before the decorators below run;
 # and the solver's pixel blocks.
-from ..kernels import _BLOCK_PIXELS
+from ..kernels import _BLOCK_PIXELS, typed_frames
 
 _FAST = {'reassoc', 'contract', 'nsz'}
 
@@ -78,8 +77,7 @@ def normal_equations(frames, held_out, temporals):
         Each channel's temporal factors ``V``.
 
     """
-    # A typed list: one compiled kernel whatever the window's length.
-    frames = List([np.ascontiguousarray(frame, dtype=np.float32) for frame in frames])
+    frames = typed_frames(frames)
     held_out = np.ascontiguousarray(held_out, dtype=np.float32)
     channels, n = frames[0].shape
     ranks = np.array([t.shape[1] for t in temporals], dtype=np.int64)

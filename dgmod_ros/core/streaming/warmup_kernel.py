@@ -24,11 +24,10 @@ settings (cache folder, ``threadsafe`` threading layer) hold here too.
 """
 
 from numba import njit
-from numba.typed import List
 import numpy as np
 
 # numba's cache folder and threading layer, set before the decorators below run.
-from .. import kernels  # noqa: F401
+from ..kernels import typed_frames
 
 
 #: Most frames whose per-entry median the compiled network takes (the
@@ -97,11 +96,6 @@ def _difference_magnitudes(frames, out):
                 row[i] = value if largest == largest and not value <= largest else largest
 
 
-def _typed(frames):
-    # One compiled kernel whatever the count; C-ordered float32 as compiled at start-up.
-    return List([np.ascontiguousarray(frame, dtype=np.float32) for frame in frames])
-
-
 def entry_medians(frames):
     """
     Return each entry's median over ``frames`` (C, n), as ``np.median`` of their stack.
@@ -112,7 +106,7 @@ def entry_medians(frames):
     """
     if len(frames) > NETWORK_FRAMES:
         return np.median(np.stack(frames, axis=2), axis=2)
-    frames = _typed(frames)
+    frames = typed_frames(frames)
     out = np.empty(frames[0].shape, dtype=np.float32)
     _entry_medians(frames, out)
     return out
@@ -125,7 +119,7 @@ def difference_magnitudes(frames):
     Row ``j`` holds, at every pixel, the largest absolute difference over the
     channels between frames ``j + 1`` and ``j`` (NaN where a channel's is).
     """
-    frames = _typed(frames)
+    frames = typed_frames(frames)
     out = np.empty((len(frames) - 1, frames[0].shape[1]), dtype=np.float32)
     if len(frames) > 1:
         _difference_magnitudes(frames, out)
