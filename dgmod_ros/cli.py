@@ -27,10 +27,11 @@ import time
 import cv2
 
 from . import config
+from .config import BATCH, STREAM
 from .core.preprocess import to_uint8
 from .core.runtime import keep_freed_memory, yield_to_compute
 from .evaluation import evaluate
-from .inputs import BadInput, count_frames, read_frames
+from .inputs import BadInput, count_frames, input_kind, read_frames
 from .sequence import results
 
 
@@ -68,29 +69,84 @@ class Progress:
         self.stream.flush()
 
 
-def _add_parameter_options(parser):
-    group = parser.add_argument_group('model, window and mask parameters (defaults: the '
-                                      "node's; see config/detector.yaml)")
-    for spec in config.PARAMETERS:
-        if spec.node_only:
-            continue
-        kind = type(spec.default)
-        option = '--' + spec.name.replace('_', '-')
-        kwargs = {'dest': spec.name, 'default': None, 'help': spec.description}
-        if spec.choices:
-            kwargs['choices'] = spec.choices
-        else:
-            kwargs['type'] = kind
-        group.add_argument(option, **kwargs)
-    parser.add_argument('--threshold', type=float, default=None,
-                        help='fixed mask threshold for every method (= --mask-threshold)')
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line (the usage of ~60 options is not)."""
+
+    def error(self, message):
+        self.exit(2, f'{self.prog}: error: {message} (see {self.prog} --help)\n')
+
+
+class _BooleanValue(argparse.Action):
+    """``--x`` alone, or ``--x VALUE`` with true/false, yes/no, on/off, 1/0 (``--no-x``: false)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        try:
+            value = True if values is None else config.parse_bool(values)
+        except ValueError as error:
+            raise argparse.ArgumentError(self, str(error)) from None
+        setattr(namespace, self.dest, value)
+
+
+class _Removed(argparse.Action):
+    """An option that was removed: refused with the name of the one that replaced it (const)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        raise argparse.ArgumentError(self, self.const)
+
+
+#: Options that were removed, and what replaced them.
+_REMOVED_OPTIONS = {'--threshold': 'removed (it was --mask-threshold again): use '
+                                   '--mask-threshold'}
+
+_MODE_TAGS = {(STREAM, BATCH): '', (STREAM,): ' [stream]', (BATCH,): ' [batch]'}
+
+PARAMETER_HELP = ("parameters: the node's, defaults as in config/detector.yaml. [stream] or "
+                  '[batch]: read in that --mode only. "Acts only with ...": no effect otherwise '
+                  '(dgmod warns). Booleans: --x, --x true|false|yes|no|on|off|1|0, or --no-x.')
+
+
+def option_name(name):
+    """Return the command-line option of parameter ``name``."""
+    return '--' + name.replace('_', '-')
+
+
+def offline_parameters(command):
+    """Return the table's parameters ``dgmod COMMAND`` offers as options."""
+    # evaluate runs --methods; a --method beside it would do nothing.
+    return [spec for spec in config.PARAMETERS if spec.where != 'node'
+            and not (command == 'evaluate' and spec.name == 'method')]
+
+
+def _add_parameter_options(parser, command):
+    for title, specs in config.parameter_groups(offline_parameters(command)):
+        group = parser.add_argument_group(title)
+        for spec in specs:
+            option = option_name(spec.name)
+            tag = _MODE_TAGS[tuple(c for c in (STREAM, BATCH) if c in spec.acts)]
+            kwargs = {'dest': spec.name, 'default': None,
+                      'help': (config.describe(spec) + tag).replace('%', '%%')}
+            if isinstance(spec.default, bool):
+                group.add_argument(option, action=_BooleanValue, nargs='?', metavar='BOOL',
+                                   **kwargs)
+                group.add_argument('--no-' + option[2:], dest=spec.name, action='store_const',
+                                   const=False, help=argparse.SUPPRESS)
+                continue
+            if spec.choices:
+                kwargs['choices'] = spec.choices
+            else:
+                kwargs['type'] = type(spec.default)
+            group.add_argument(option, **kwargs)
+    for option, message in _REMOVED_OPTIONS.items():
+        parser.add_argument(option, action=_Removed, nargs='?', const=message,
+                            help=argparse.SUPPRESS)
 
 
 def build_parser():
     """Return the argument parser of ``dgmod``."""
-    parser = argparse.ArgumentParser(prog='dgmod', description=__doc__.strip().splitlines()[0])
+    parser = _Parser(prog='dgmod', description=__doc__.strip().splitlines()[0])
     commands = parser.add_subparsers(dest='command', required=True)
-    separate = commands.add_parser('separate', help='run one method over one input')
+    separate = commands.add_parser('separate', help='run one method over one input',
+                                   description=PARAMETER_HELP)
     separate.add_argument('input', help='folder of frames (plain or CDnet-style), video file, '
                           'or rosbag2 (folder, .mcap, .db3)')
     separate.add_argument('--out', required=True, help='output folder')
@@ -103,35 +159,61 @@ def build_parser():
                                'them, instead of stopping')
     separate.add_argument('--force', action='store_true', help='replace an existing --out')
     separate.add_argument('--quiet', action='store_true', help='no progress bar')
-    _add_parameter_options(separate)
+    _add_parameter_options(separate, 'separate')
     evaluate = commands.add_parser('evaluate', help="the paper's comparison on CDnet-style "
-                                   'datasets with ground truth')
+                                   'datasets with ground truth', description=PARAMETER_HELP)
     evaluate.add_argument('datasets', nargs='+', help='CDnet-style folders (input/, '
                           'groundtruth/, temporalROI.txt)')
     evaluate.add_argument('--methods', default=','.join(config.BY_NAME['method'].choices),
                           help='comma-separated methods (default: all)')
-    evaluate.add_argument('--mode', choices=('stream', 'batch'), default='stream')
+    evaluate.add_argument('--mode', choices=('stream', 'batch'), default='stream',
+                          help='stream: what the node does (causal); batch: whole windows')
     evaluate.add_argument('--out', required=True, help='folder for results and figures')
     evaluate.add_argument('--config', help="the node's YAML parameter file")
-    _add_parameter_options(evaluate)
+    _add_parameter_options(evaluate, 'evaluate')
     return parser
 
 
 def resolve_parameters(args):
-    """Return the full parameter set: defaults, then ``--config``, then options."""
+    """
+    Return the full parameter set and where the user gave each parameter.
+
+    Defaults, then ``--config``, then options. The second value maps each
+    parameter given (an option, or a value of the file other than the
+    default) to how to name it in a message.
+    """
     values = dict(config.DEFAULTS)
+    given = {}
     if args.config:
-        values.update(config.load_parameter_file(args.config))
+        from_file = config.load_parameter_file(args.config)
+        values.update(from_file)
+        given.update({name: f'{name} (in {args.config})' for name, value in from_file.items()
+                      if value != config.DEFAULTS[name]})
     for spec in config.PARAMETERS:
-        given = getattr(args, spec.name, None)
-        if given is not None:
-            values[spec.name] = given
-    if args.threshold is not None:
-        values['mask_threshold'] = args.threshold
+        value = getattr(args, spec.name, None)
+        if value is not None:
+            values[spec.name] = value
+            given[spec.name] = option_name(spec.name)
     for name, value in values.items():   # YAML ints for floats are fine offline
-        if isinstance(config.DEFAULTS[name], float) and isinstance(value, int):
+        if isinstance(config.DEFAULTS[name], float) and isinstance(value, int) \
+                and not isinstance(value, bool):
             values[name] = float(value)
-    return config.validate(values)
+    return config.validate(values), given
+
+
+def warn_inert(values, given, mode, methods=None, stream=None):
+    """
+    Print one warning line for each parameter given that has no effect here.
+
+    With ``methods`` (evaluate), only for those inert under every one of them.
+    """
+    inert = None
+    for method in methods or (values['method'],):
+        found = config.inert_parameters(dict(values, method=method), given, mode)
+        inert = found if inert is None else {n: r for n, r in inert.items() if n in found}
+    for name, reason in inert.items():
+        print(f'dgmod: warning: {given[name]} has no effect: {reason}',
+              file=stream or sys.stderr)
 
 
 def _good_frames(frames, skip_bad, skipped):
@@ -241,7 +323,9 @@ def _background_png(background):
 
 def separate(args):
     """Run ``dgmod separate``; return the report dict."""
-    values = resolve_parameters(args)
+    input_kind(args.input)                      # a missing input: one line, before anything
+    values, given = resolve_parameters(args)
+    warn_inert(values, given, args.mode)
     out = Path(args.out)
     if out.exists() and not args.force:
         raise BadInput(f'{out} exists; choose another --out or pass --force')
@@ -250,13 +334,13 @@ def separate(args):
     (partial / 'masks').mkdir(parents=True)
     (partial / 'background').mkdir()
     skipped = []
-    progress = Progress(f'{values["method"]} {args.mode}', count_frames(args.input, args.topic),
-                        stream=io.StringIO() if args.quiet else sys.stderr)
     # Before the clock: the report's rate is the stream's, and start-up is
     # reported apart (docs/node.md).
     loading = time.perf_counter()
     config.load_kernels(values)
     started = time.perf_counter()
+    progress = Progress(f'{values["method"]} {args.mode}', count_frames(args.input, args.topic),
+                        stream=io.StringIO() if args.quiet else sys.stderr)
     windows = []
     writer = PngWriter()
     try:
@@ -299,10 +383,11 @@ def separate(args):
 
 def run_evaluation(args):
     """Run ``dgmod evaluate`` and print one line per (dataset, method)."""
-    values = resolve_parameters(args)
+    values, given = resolve_parameters(args)
     methods = [m.strip() for m in args.methods.split(',') if m.strip()]
     for method in methods:
         config.check_value('method', method)
+    warn_inert(values, given, args.mode, methods)
 
     def show(row):
         print(f"{row['dataset']:>14} {row['method']:>7}: F {row['fmeasure']:.3f} (Pr "

@@ -25,9 +25,69 @@ from .core.streaming import SlidingWindowDetector
 from .core.subtractors import OpenCVSubtractor, OpenCVWindowModel
 
 
+#: Where a parameter can be read: the node, ``dgmod --mode stream`` (the node's
+#: streaming detector offline), ``dgmod --mode batch`` (windows tiling a sequence).
+NODE, STREAM, BATCH = 'node', 'stream', 'batch'
+STREAMING = (NODE, STREAM)
+EVERYWHERE = (NODE, STREAM, BATCH)
+OFFLINE = (STREAM, BATCH)
+NODE_ONLY = (NODE,)
+
+#: Methods that update a per-pixel model with every frame instead of solving windows.
+_OPENCV_METHODS = ('mog2', 'knn')
+#: Window methods: the sliding window, its solves and the per-pixel decision.
+_WINDOW_METHODS = ('dgmod', 'lago', 'spcp', 'spgl1', 'ialm', 'frpcag', 'median')
+
+
+class Not:
+    """An ``active_when`` value: the parameter acts while the other is none of ``values``."""
+
+    def __init__(self, *values):
+        self.values = values
+
+    def __contains__(self, value):
+        return value not in self.values
+
+    def __eq__(self, other):
+        return isinstance(other, Not) and other.values == self.values
+
+    def __hash__(self):
+        return hash(self.values)
+
+    def __repr__(self):
+        return 'Not(' + ', '.join(map(repr, self.values)) + ')'
+
+
+def _allowed(value):
+    """Normalise one ``active_when`` value: a :class:`Not`, or a tuple of the allowed values."""
+    return value if isinstance(value, (Not, tuple)) else (value,)
+
+
+#: ``active_when`` shorthands: the dual-graph model's own weights and solver; a
+#: sliding-window detector; its per-pixel decisions; one global threshold.
+_DGMOD = {'method': 'dgmod'}
+_WINDOW = {'method': Not(*_OPENCV_METHODS)}
+_PER_PIXEL = {'decision': ('adaptive', 'uniform')}
+_GLOBAL = {'decision': 'global'}
+
+
 @dataclass(frozen=True)
 class Parameter:
-    """One parameter: name, default, description and the range ROS enforces."""
+    """
+    One parameter: name, default, description, the range ROS enforces, where it acts.
+
+    ``acts`` names where it is read (:data:`NODE`, :data:`STREAM`, :data:`BATCH`;
+    the node declares only those with :data:`NODE`, the command line offers the
+    others). ``advanced`` marks a solver internal: the defaults are measured
+    (docs/solver.md, docs/results.md), and ``config/detector.yaml`` and
+    ``--help`` list them apart. ``active_when`` says when the parameter has an
+    effect at all: a mapping ``{other parameter: value or tuple of values or
+    Not(values)}`` (all must hold), or a tuple of such mappings (any); a
+    condition on a parameter that is not read where this one is read (say
+    ``decision`` in batch mode) holds, one on a parameter that is read there
+    but has no effect itself does not. :func:`inert_parameters` reads it; the
+    descriptions the node, the YAML file and ``--help`` show say it.
+    """
 
     name: str
     default: object
@@ -37,172 +97,320 @@ class Parameter:
     step: int = 1
     choices: tuple = ()
     read_only: bool = False
-    node_only: bool = False     # no meaning offline: the command line has no option for it
+    acts: tuple = STREAMING
+    advanced: bool = False
+    active_when: object = ()
+
+    def __post_init__(self):
+        # One canonical form, hashable: a tuple of alternatives, each a tuple of
+        # (name, allowed) pairs.
+        when = self.active_when
+        alternatives = (when,) if isinstance(when, dict) else tuple(when)
+        object.__setattr__(self, 'active_when', tuple(
+            tuple((name, _allowed(value)) for name, value in alternative.items())
+            for alternative in alternatives))
+        unknown = set(self.acts) - set(EVERYWHERE)
+        if unknown or not self.acts:
+            raise ValueError(f'{self.name}: acts must name some of {EVERYWHERE}')
+
+    @property
+    def where(self):
+        """'node' (the node only), 'offline' (the command line only) or 'both'."""
+        if NODE not in self.acts:
+            return 'offline'
+        return 'both' if set(self.acts) & set(OFFLINE) else 'node'
 
 
+#: Every parameter. A new one is one entry: name, default, description, range
+#: (low, high[, step]) or choices, and where they differ from the defaults
+#: ``acts`` (default: the streaming detector, node and stream mode),
+#: ``active_when``, ``advanced``, ``read_only``.
 PARAMETERS = (
     # Method and window.
     Parameter('method', 'dgmod', 'separation method: dgmod (the dual-graph model); the '
               "paper's comparators lago, spcp, spgl1 (fastRPCA); ialm (classical PCP); frpcag "
               '(graphs without the nuclear norm); median (temporal median); OpenCV mog2 / knn '
               'run per frame. Comparators use their documented defaults.',
-              choices=('dgmod', 'lago', 'spcp', 'spgl1', 'ialm', 'frpcag', 'median', 'mog2',
-                       'knn')),
-    Parameter('window', 30, 'frames m in the sliding window', 2, 300),
+              choices=_WINDOW_METHODS + _OPENCV_METHODS, acts=EVERYWHERE),
+    Parameter('window', 30, 'frames m in the sliding window', 2, 300, acts=EVERYWHERE),
     Parameter('stride', 10, 'buffered frames between window solves (<= window)', 1, 300),
     Parameter('scale', 0.5, 'processing scale of frames for the per-frame path (projection, '
               'decision) and the window; masks come back at input size. The window solve runs '
-              'at this scale up to solve_pixels', 0.05, 1.0),
+              'at this scale up to solve_pixels', 0.05, 1.0, acts=EVERYWHERE),
     Parameter('color', 'rgb', 'gray: one luma channel; rgb: each channel solved, fused by '
-              'the largest magnitude', choices=('gray', 'rgb')),
+              'the largest magnitude', choices=('gray', 'rgb'), acts=EVERYWHERE),
     Parameter('min_frames', 5, 'frames before the first solve (<= window); until then masks '
-              'use the per-pixel median of the buffer', 2, 300),
+              'use the per-pixel median of the buffer', 2, 300, active_when=_WINDOW),
     Parameter('basis_rank', 2, 'background components the per-frame fast path projects on',
-              1, 20),
+              1, 20, active_when=_WINDOW),
     Parameter('global_change_fraction', 0.7, 'foreground share of two consecutive frames '
               'that restarts the window (light switched, exposure jump); 1.0 disables',
-              0.01, 1.0),
+              0.01, 1.0, active_when=_WINDOW),
     Parameter('memory_spacing', 10, 'frames between admissions to the full window, which '
-              'then spans window * memory_spacing frames; 1 = consecutive frames', 1, 1000),
+              'then spans window * memory_spacing frames; 1 = consecutive frames', 1, 1000,
+              active_when=_WINDOW),
     Parameter('conditional_update', True, 'admit frames with their foreground replaced by the '
-              'background, so that a person who stops stays foreground'),
+              'background, so that a person who stops stays foreground', active_when=_WINDOW),
     Parameter('hold_changes', False, 'the conditional update also keeps out the pixels over '
               'pixel_k / 2 noise levels from the background that change as much within 5 '
               'frames or have been away for fewer than still_frames frames (something '
-              'passing that the mask missed)'),
+              'passing that the mask missed)',
+              active_when={'conditional_update': True, **_PER_PIXEL}),
     Parameter('absorb_frames', 300, 'foreground older than this many frames enters the '
-              'window as it is (a left object then joins the background)', 1, 1000000),
+              'window as it is (a left object then joins the background)', 1, 1000000,
+              active_when={'conditional_update': True}),
     Parameter('motion_threshold', 0.0, 'frames whose mean absolute change to the last '
               'buffered frame is below this are masked but not buffered; 0 buffers all',
-              0.0, 1.0),
+              0.0, 1.0, active_when=_WINDOW),
     Parameter('value_range', 0.0, 'pixel value meaning full scale (for example 5000.0 for '
-              '16UC1 depth in mm); 0 uses the type range (floats: 1.0)', 0.0, 1e9),
+              '16UC1 depth in mm); 0 uses the type range (floats: 1.0)', 0.0, 1e9,
+              acts=EVERYWHERE),
     # Model (Algorithm 1).
     Parameter('lambda1', 0.0, 'weight of the weighted nuclear norm; 0 = automatic, lambda2 '
               '* sqrt(max(n, m)) (as in the core; the model without the term is frpcag)',
-              0.0, 1e6),
+              0.0, 1e6, acts=EVERYWHERE, active_when=_DGMOD),
     Parameter('lambda2', 0.5, 'weight of ||S||_1; below 1 so that S takes the foreground',
-              1e-6, 0.999),
-    Parameter('gamma1', 0.5, 'weight of the spatial graph term', 0.0, 1e3),
-    Parameter('gamma2', 0.5, 'weight of the temporal graph term', 0.0, 1e3),
-    Parameter('rho1', 20.0, 'ADMM penalty of U = L', 1e-3, 1e6),
-    Parameter('rho2', 20.0, 'ADMM penalty of V = D - L - S', 1e-3, 1e6),
+              1e-6, 0.999, acts=EVERYWHERE, active_when=_DGMOD),
+    Parameter('gamma1', 0.5, 'weight of the spatial graph term', 0.0, 1e3, acts=EVERYWHERE,
+              active_when=_DGMOD),
+    Parameter('gamma2', 0.5, 'weight of the temporal graph term', 0.0, 1e3, acts=EVERYWHERE,
+              active_when=_DGMOD),
+    Parameter('rho1', 20.0, 'ADMM penalty of U = L', 1e-3, 1e6, acts=EVERYWHERE,
+              active_when=_DGMOD, advanced=True),
+    Parameter('rho2', 20.0, 'ADMM penalty of V = D - L - S', 1e-3, 1e6, acts=EVERYWHERE,
+              active_when=_DGMOD, advanced=True),
     Parameter('weight_scale', 0.0, 'scale s of the weights exp(-sigma^2/s^2); 0 = 0.1 * '
-              'largest singular value of the window', 0.0, 1e9),
-    Parameter('h_s', 0.0, 'spatial filtering parameter; 0 = median patch distance', 0.0, 1e9),
+              'largest singular value of the window', 0.0, 1e9, acts=EVERYWHERE,
+              active_when=_DGMOD),
+    Parameter('h_s', 0.0, 'spatial filtering parameter; 0 = median patch distance', 0.0, 1e9,
+              acts=EVERYWHERE, active_when=_DGMOD),
     Parameter('h_t', 0.0, 'temporal filtering parameter; 0 = median frame distance',
-              0.0, 1e9),
-    Parameter('patch_size', 3, 'odd side p of the patches of the spatial graph', 1, 15, 2),
+              0.0, 1e9, acts=EVERYWHERE, active_when=_DGMOD),
+    Parameter('patch_size', 3, 'odd side p of the patches of the spatial graph', 1, 15, 2,
+              acts=EVERYWHERE, active_when=_DGMOD),
     Parameter('smoothing_sigma', 0.0, 'Gaussian pre-smoothing (pixels) before patch '
-              'distances; 0 = off', 0.0, 10.0),
+              'distances; 0 = off', 0.0, 10.0, acts=EVERYWHERE, active_when=_DGMOD),
     Parameter('temporal_neighbors', 4, 'frames joined to each frame in the temporal graph',
-              2, 20),
+              2, 20, acts=EVERYWHERE, active_when=_DGMOD),
     Parameter('l_step', 'gradient', 'L-step: gradient (paper) or exact (block CG in the '
-              'temporal eigenbasis)', choices=('gradient', 'exact')),
-    Parameter('inner_iter', 1, 'gradient steps or CG iterations per L-step (T_in)', 1, 50),
+              'temporal eigenbasis)', choices=('gradient', 'exact'), acts=EVERYWHERE,
+              active_when=_DGMOD, advanced=True),
+    Parameter('inner_iter', 1, 'gradient steps or CG iterations per L-step (T_in)', 1, 50,
+              acts=EVERYWHERE, active_when=_DGMOD, advanced=True),
     Parameter('tol', 1e-3, 'stop when relative changes and residuals are below this',
-              1e-8, 0.1),
-    Parameter('max_iter', 300, 'ADMM sweeps per window solve at most (T_out) in batch mode',
-              1, 10000),
+              1e-8, 0.1, acts=EVERYWHERE, active_when=_DGMOD, advanced=True),
+    Parameter('max_iter', 300, 'ADMM sweeps per window solve at most (T_out) in batch mode '
+              '(streaming solves take stream_max_iter)', 1, 10000, acts=(BATCH,),
+              active_when=_DGMOD, advanced=True),
     Parameter('solve_lag', 5, 'frames between the window snapshot of a solve and its install '
               '(at most stride): the solve runs beside that many frames of per-frame work, and '
               'the masks do not depend on its speed (sync mode and offline; async installs a '
-              'solve when it ends, about 5 frames at 30 frames/s)', 0, 300),
+              'solve when it ends, about 5 frames at 30 frames/s)', 0, 300,
+              active_when={**_WINDOW, 'solve_mode': 'sync'}, advanced=True),
     Parameter('solve_pixels', 19200, 'largest frame (pixels) the window solve runs at: a '
               'larger one (after solve_scale) is solved scaled down to this, same aspect, and '
               "its full-size background fit from the solve's temporal factors (19200 = 160 x "
-              '120, a 640 x 480 camera at the default scale and solve_scale)', 64, 100000000),
+              '120, a 640 x 480 camera at the default scale and solve_scale)', 64, 100000000,
+              active_when=_WINDOW, advanced=True),
     Parameter('solve_scale', 0.5, 'scale of the window solve against the processing size '
               '(before the solve_pixels cap); the full-size background is fit from the '
-              "solve's temporal factors", 0.05, 1.0),
+              "solve's temporal factors", 0.05, 1.0, active_when=_WINDOW),
     Parameter('refit_background', True, "the background is each pixel's own series fit on "
               "the solve's leading temporal factors, the solve's foreground held out, also "
-              "when the solve runs at the processing size; false: the solve's own L there"),
+              "when the solve runs at the processing size; false: the solve's own L there",
+              active_when=_WINDOW, advanced=True),
     Parameter('stream_max_iter', 3, 'ADMM sweeps per window solve while streaming (node, '
               'stream mode): each solve starts from the last, so sweeps add up over '
-              'overlapping windows', 1, 10000),
+              'overlapping windows', 1, 10000, active_when=_DGMOD, advanced=True),
     Parameter('solve_threads', 1, "threads of the window solve's compiled kernels where it "
               'runs beside the per-frame work (the async node, stream mode); 1 leaves the other '
               'cores to the image callback, DDS and the camera driver; 0 = one per core. The '
-              'masks do not depend on it', 0, 1024, read_only=True),
+              'masks do not depend on it', 0, 1024, read_only=True, active_when=_WINDOW),
     # Masks.
     Parameter('decision', 'adaptive', 'adaptive: each pixel against pixel_k times its own noise '
               "level from the window's residual; uniform: one level for all pixels; global: "
               'the mask_* rule (one threshold, morphology)',
-              choices=('adaptive', 'uniform', 'global')),
+              choices=('adaptive', 'uniform', 'global'), active_when=_WINDOW),
     Parameter('noise_source', 'solve', "residual of the window that gives each pixel's noise "
               "level: solve: the solve's D - L; projection / least_squares: each frame against "
               "its robust / least-squares projection on the fast path's basis (what the per-frame "
               'decision thresholds); max: the larger of the solve and projection levels',
-              choices=('solve', 'projection', 'least_squares', 'max')),
+              choices=('solve', 'projection', 'least_squares', 'max'), active_when=_PER_PIXEL,
+              advanced=True),
     Parameter('ghost_test', True, 'drop still blobs whose outline is an edge of the background '
-              'rather than of the frame (ghosts of what has left); they heal the window'),
+              'rather than of the frame (ghosts of what has left); they heal the window',
+              active_when=_PER_PIXEL),
     Parameter('still_frames', 25, 'drop pixels that have been in a still blob (nothing in it '
               'changed by pixel_k / 2 noise levels over 5 frames) for this many frames: ghosts '
-              'that uncover texture; they heal the window; 0 = off', 0, 1000000),
+              'that uncover texture; they heal the window; 0 = off', 0, 1000000,
+              active_when=_PER_PIXEL),
     Parameter('mrf_beta', 2.0, 'coupling of 5 x 5 neighbours in the Potts field that decides '
-              'the adaptive mask (log-odds per neighbour, mean field); 0 = threshold and '
-              'median filter', 0.0, 100.0),
-    Parameter('pixel_k', 6.0, 'multiple of the noise level that makes a pixel foreground '
-              '(adaptive, uniform)', 0.1, 100.0),
-    Parameter('median_size', 5, 'median filter of the adaptive decision at the processing '
-              'size (odd; 1 = off)', 1, 15, 2),
+              'the per-pixel mask (log-odds per neighbour, mean field); 0 = threshold and '
+              'median filter (median_size)', 0.0, 100.0, active_when=_PER_PIXEL),
+    Parameter('pixel_k', 6.0, 'multiple of the noise level that makes a pixel foreground',
+              0.1, 100.0, active_when=_PER_PIXEL),
+    Parameter('median_size', 5, 'median filter of the thresholded per-pixel decision at the '
+              'processing size (odd; 1 = off)', 1, 15, 2,
+              active_when={**_PER_PIXEL, 'mrf_beta': 0.0}),
     Parameter('chroma_cue', True, 'a change of light (shadow, reflection) keeps the '
               'chromaticity: pixels whose chromaticity distortion stays within pixel_k noise '
-              'levels may be taken for one (adaptive, uniform; rgb)'),
+              'levels may be taken for one (rgb)', active_when=_PER_PIXEL),
     Parameter('texture_cue', True, 'a change of light keeps the local texture: pixels whose '
               'LBSP descriptor stays within texture_bits of the background may be taken for '
-              'one (adaptive, uniform)'),
+              'one', active_when=_PER_PIXEL),
     Parameter('texture_bits', 8, 'largest LBSP Hamming distance (of 16 bits per channel) of a '
-              'change of light', 0, 48),
+              'change of light', 0, 48, active_when={'texture_cue': True}),
     Parameter('moving_texture_k', 3.0, 'pixels whose LBSP texture changed (moving_texture_bits '
               'or more) and that moved over 5 frames are foreground from this multiple of the '
               'noise level instead of pixel_k (a person whose colour matches what is behind); '
-              '0 = off (adaptive, uniform)', 0.0, 100.0),
+              '0 = off', 0.0, 100.0, active_when=_PER_PIXEL),
     Parameter('moving_texture_bits', 16, 'fewest differing LBSP bits (of 16 per channel) of a '
-              'changed texture for moving_texture_k', 0, 48),
+              'changed texture for moving_texture_k', 0, 48,
+              active_when={'moving_texture_k': Not(0.0)}),
     Parameter('mask_threshold', 0.0, 'fixed threshold on |S| for data in [0, 1]; 0 = auto '
-              '(max(mask_min_threshold, mask_k * robust sigma of D - L))', 0.0, 1.0),
+              '(max(mask_min_threshold, mask_k * robust sigma of D - L))', 0.0, 1.0,
+              acts=EVERYWHERE, active_when=_GLOBAL),
     Parameter('mask_k', 5.0, 'multiple of the robust noise level of the auto threshold',
-              0.1, 100.0),
-    Parameter('mask_min_threshold', 0.1, 'floor of the auto threshold', 0.0, 1.0),
+              0.1, 100.0, acts=EVERYWHERE, active_when={**_GLOBAL, 'mask_threshold': 0.0}),
+    Parameter('mask_min_threshold', 0.1, 'floor of the auto threshold', 0.0, 1.0,
+              acts=EVERYWHERE, active_when={**_GLOBAL, 'mask_threshold': 0.0}),
     Parameter('morph_size', 3, 'kernel of the morphological opening and closing; 0 = off',
-              0, 15),
+              0, 15, acts=EVERYWHERE, active_when=(_GLOBAL, {'method': _OPENCV_METHODS})),
     # Node only (no command-line option).
     Parameter('solve_mode', 'async', 'async: solves run in a worker thread while frames are '
               'masked; sync: in the image callback (deterministic, for replays)',
-              choices=('async', 'sync'), node_only=True),
+              choices=('async', 'sync'), acts=NODE_ONLY),
     Parameter('max_pixels', 4096 * 4096, 'refuse images with more pixels than this',
-              1, 1 << 30, node_only=True),
+              1, 1 << 30, acts=NODE_ONLY),
     Parameter('publish_overlay', False, 'publish foreground_overlay (rgb8) for rviz',
-              node_only=True),
+              acts=NODE_ONLY),
     Parameter('diagnostics_period', 1.0, 'seconds between /diagnostics messages', 0.1, 60.0,
-              node_only=True),
+              acts=NODE_ONLY),
     Parameter('solve_timeout', 10.0, 'diagnostics warn when a window solve has been due '
               'this many seconds with none finished while frames arrive (a frozen '
-              'background); 0 = never', 0.0, 3600.0, node_only=True),
+              'background); 0 = never', 0.0, 3600.0, acts=NODE_ONLY),
     Parameter('foreground_jump', 0.3, 'diagnostics warn when the foreground share of the '
               'frame changes by more than this between consecutive frames (camera moved, '
-              'lights); 1.0 disables', 0.01, 1.0, node_only=True),
+              'lights); 1.0 disables', 0.01, 1.0, acts=NODE_ONLY),
     Parameter('input_transport', 'raw', 'raw: subscribe image (sensor_msgs/Image); '
               'compressed: subscribe image/compressed (sensor_msgs/CompressedImage, JPEG or '
               'PNG, as image_transport offers it)', choices=('raw', 'compressed'),
-              read_only=True, node_only=True),
+              read_only=True, acts=NODE_ONLY),
     Parameter('autostart', True, 'configure and activate the lifecycle node at start-up; '
-              'false waits for a lifecycle manager', read_only=True, node_only=True),
+              'false waits for a lifecycle manager', read_only=True, acts=NODE_ONLY),
     # Depth (people in 3-D for planners).
     Parameter('use_depth', False, 'also subscribe depth/image_rect (16UC1 mm or 32FC1 m, '
               'registered to image) and depth/camera_info, and publish foreground_points and '
               'foreground_depth/image_rect + camera_info for every paired frame',
-              read_only=True, node_only=True),
+              read_only=True, acts=NODE_ONLY),
     Parameter('depth_slop', 0.02, 'largest stamp difference (seconds) of a colour frame and '
-              'the depth image paired with it', 0.0, 1.0, node_only=True),
+              'the depth image paired with it', 0.0, 1.0, acts=NODE_ONLY,
+              active_when={'use_depth': True}),
     Parameter('cloud_pixel_step', 2, 'foreground_points takes every n-th pixel in both '
-              'directions (1 = every foreground pixel)', 1, 16, node_only=True),
+              'directions (1 = every foreground pixel)', 1, 16, acts=NODE_ONLY,
+              active_when={'use_depth': True}),
 )
 
 BY_NAME = {p.name: p for p in PARAMETERS}
 DEFAULTS = {p.name: p.default for p in PARAMETERS}
+
+
+def reads(context):
+    """Return the parameters read in ``context`` (:data:`NODE`, :data:`STREAM`, :data:`BATCH`)."""
+    return tuple(p for p in PARAMETERS if context in p.acts)
+
+
+def is_active(name, values, context):
+    """
+    Tell whether parameter ``name`` has an effect under ``values`` in ``context``.
+
+    Read from the table: ``acts`` and ``active_when`` (see :class:`Parameter`).
+    """
+    spec = BY_NAME[name]
+    if context not in spec.acts:
+        return False
+    return not spec.active_when or any(
+        all(_condition_holds(other, allowed, values, context) for other, allowed in alternative)
+        for alternative in spec.active_when)
+
+
+def _condition_holds(name, allowed, values, context):
+    if context not in BY_NAME[name].acts:
+        return True                 # not read here, so it decides nothing here
+    return values[name] in allowed and is_active(name, values, context)
+
+
+def _text(value):
+    return _yaml_scalar(value) if isinstance(value, bool) else str(value)
+
+
+def _condition_text(name, allowed):
+    if isinstance(allowed, Not):
+        return f'{name} not {"|".join(map(_text, allowed.values))}'
+    return f'{name}={"|".join(map(_text, allowed))}'
+
+
+def conditions_text(spec):
+    """Return ``spec.active_when`` in words ('decision=global and mask_threshold=0.0'), or ''."""
+    return ', or with '.join(' and '.join(_condition_text(name, allowed)
+                                          for name, allowed in alternative)
+                             for alternative in spec.active_when)
+
+
+def describe(spec):
+    """Return the description the node, the YAML file and ``--help`` show: when it acts too."""
+    conditions = conditions_text(spec)
+    if not conditions:
+        return spec.description
+    return f'{spec.description.rstrip(".")}. Acts only with {conditions}.'
+
+
+_CONTEXT_NAMES = {NODE: 'the node', STREAM: 'dgmod --mode stream', BATCH: 'dgmod --mode batch'}
+
+
+def inert_reason(name, values, context):
+    """Return, in words, why ``name`` has no effect under ``values`` in ``context``; else None."""
+    spec = BY_NAME[name]
+    if context not in spec.acts:
+        return 'it is read only by ' + ' and '.join(_CONTEXT_NAMES[c] for c in spec.acts)
+    if is_active(name, values, context):
+        return None
+    controllers = list(dict.fromkeys(other for alternative in spec.active_when
+                                     for other, _ in alternative
+                                     if context in BY_NAME[other].acts))
+    reason = f'it acts only with {conditions_text(spec)} (' + ', '.join(
+        f'{other} is {_text(values[other])}' for other in controllers) + ')'
+    # Every value as asked, yet inert: a parameter it depends on has no effect itself.
+    for alternative in spec.active_when:
+        named = [(other, allowed) for other, allowed in alternative
+                 if context in BY_NAME[other].acts]
+        if all(values[other] in allowed for other, allowed in named):
+            other = next(o for o, _ in named if not is_active(o, values, context))
+            return f'{reason}, and {other} has no effect: ' + \
+                inert_reason(other, values, context)[len('it '):]
+    return reason
+
+
+def inert_parameters(values, names, context):
+    """Return ``{name: reason}`` for those of ``names`` that have no effect under ``values``."""
+    reasons = {name: inert_reason(name, values, context) for name in names if name in BY_NAME}
+    return {name: reason for name, reason in reasons.items() if reason is not None}
+
+
+def parse_bool(text):
+    """Return the boolean a user typed: true/false, yes/no, on/off, 1/0 (any case)."""
+    word = str(text).strip().lower()
+    if word in ('true', 'yes', 'on', '1'):
+        return True
+    if word in ('false', 'no', 'off', '0'):
+        return False
+    raise ValueError(f'expected true or false (yes/no, on/off, 1/0), got {text!r}')
+
+
+def parse_value(name, text):
+    """Return ``text`` as a value of parameter ``name`` (its default's type)."""
+    kind = type(BY_NAME[name].default)
+    return parse_bool(text) if kind is bool else kind(text)
 
 
 def _auto(value):
@@ -210,9 +418,17 @@ def _auto(value):
     return None if value == 0 else value
 
 
+_KINDS = {bool: 'true or false', int: 'an integer', float: 'a number', str: 'a string'}
+
+
 def check_value(name, value):
-    """Raise ``ValueError`` when ``value`` is outside ``name``'s choices or range."""
+    """Raise ``ValueError`` when ``value`` is of another type, or outside the choices or range."""
     spec = BY_NAME[name]
+    kind = type(spec.default)
+    # An int for a float is fine here (the command line converts; ROS refuses it itself).
+    accepted = (int, float) if kind is float else kind
+    if isinstance(value, bool) != (kind is bool) or not isinstance(value, accepted):
+        raise ValueError(f'{name} must be {_KINDS[kind]}, got {value!r}')
     if spec.choices and value not in spec.choices:
         raise ValueError(f'{name} must be one of {", ".join(spec.choices)}, got {value!r}')
     if spec.low is not None and not spec.low <= value <= spec.high:
@@ -239,13 +455,11 @@ def build_mask_rule(values):
                     min_threshold=values['mask_min_threshold'], morph_size=values['morph_size'])
 
 
-#: Methods that update a per-pixel model with every frame instead of solving windows.
-_OPENCV_METHODS = ('mog2', 'knn')
 #: Window methods other than dgmod, built with their documented defaults.
 COMPARATORS = {'lago': LAGO, 'spcp': SplitSPCP, 'spgl1': SPGL1RPCA, 'ialm': InexactALM,
                'frpcag': FRPCAG, 'median': TemporalMedian}
 #: Parameters of the node itself: changing them leaves the detector untouched.
-NODE_PARAMETERS = tuple(p.name for p in PARAMETERS if p.node_only)
+NODE_PARAMETERS = tuple(p.name for p in PARAMETERS if p.acts == NODE_ONLY)
 
 
 def window_model(values, streaming=False):
@@ -370,10 +584,29 @@ def load_parameter_file(path):
     return dict(params)
 
 
+#: Section titles, at the first parameter of each section (the table's order).
 _SECTIONS = {'method': 'Method and sliding window',
              'lambda1': 'Model (Algorithm 1); 0.0 means automatic where stated',
-             'mask_threshold': 'Masks', 'solve_mode': 'Node',
+             'decision': 'Masks', 'solve_mode': 'Node',
              'use_depth': 'Depth: the foreground in 3-D for planners'}
+ADVANCED_TITLE = 'Advanced: solver internals (defaults measured: docs/solver.md, docs/results.md)'
+
+
+def parameter_groups(specs):
+    """
+    Return ``[(title, [Parameter, ...]), ...]``: ``specs`` by section, the advanced ones last.
+
+    One layout for ``config/detector.yaml`` and ``dgmod --help``; empty groups left out.
+    """
+    wanted = {spec.name for spec in specs}
+    groups, advanced = [], []
+    for spec in PARAMETERS:
+        if spec.name in _SECTIONS:
+            groups.append((_SECTIONS[spec.name], []))
+        if spec.name in wanted:
+            (advanced if spec.advanced else groups[-1][1]).append(spec)
+    groups.append((ADVANCED_TITLE, advanced))
+    return [(title, members) for title, members in groups if members]
 
 
 def _yaml_scalar(value):
@@ -382,22 +615,34 @@ def _yaml_scalar(value):
     return repr(value) if isinstance(value, float) else str(value)
 
 
-def parameter_file_text():
-    """Return ``config/detector.yaml``: every parameter, its default and description."""
+def _commented(spec, indent):
     import textwrap
+    allowed = (' {' + ', '.join(spec.choices) + '}' if spec.choices
+               else f' [{spec.low}, {spec.high}]' if spec.low is not None else '')
+    return [f'{indent}# ' + line for line in textwrap.wrap(describe(spec) + allowed, 88)]
+
+
+def parameter_file_text():
+    """Return ``config/detector.yaml``: every node parameter, its default and description."""
     lines = ['# Parameters of the dgmod_ros detector node, with their defaults.',
              '# Use: ros2 run dgmod_ros detector --ros-args --params-file <this file>',
              '# The offline command reads the same file: dgmod separate INPUT --config <file>',
              '# Write floats with a decimal point (1.0, not 1): ROS refuses an int for a double.',
+             '# "Acts only with ...": the parameter has no effect otherwise (the node warns).',
              '# Generated by `python -m dgmod_ros.config`; a test keeps it in step with the code.',
              '/detector:', '  ros__parameters:']
-    for spec in PARAMETERS:
-        if spec.name in _SECTIONS:
-            lines.append(f'    # --- {_SECTIONS[spec.name]}')
-        allowed = (' {' + ', '.join(spec.choices) + '}' if spec.choices
-                   else f' [{spec.low}, {spec.high}]' if spec.low is not None else '')
-        lines += ['    # ' + line for line in textwrap.wrap(spec.description + allowed, 88)]
-        lines.append(f'    {spec.name}: {_yaml_scalar(spec.default)}')
+    for title, specs in parameter_groups(reads(NODE)):
+        lines.append(f'    # --- {title}')
+        for spec in specs:
+            lines += _commented(spec, '    ')
+            lines.append(f'    {spec.name}: {_yaml_scalar(spec.default)}')
+    offline = [spec for spec in PARAMETERS if spec.where == 'offline']
+    if offline:
+        lines.append('# Not node parameters: read by the offline command only '
+                     '(dgmod ... --config <file>, or as options)')
+        for spec in offline:
+            lines += _commented(spec, '')
+            lines.append(f'#   {spec.name}: {_yaml_scalar(spec.default)}')
     return '\n'.join(lines) + '\n'
 
 

@@ -99,7 +99,8 @@ def test_launch_file_refers_only_to_names_that_exist():
                 assert path.startswith(share), path
                 relative = path[len(share):]
                 assert (REPO / relative).is_file(), relative
-                assert config.load_parameter_file(REPO / relative) == config.DEFAULTS
+                assert config.load_parameter_file(REPO / relative) == {
+                    spec.name: spec.default for spec in config.reads(config.NODE)}
             else:
                 name = param.get('name')
                 assert name in config.BY_NAME, f'no parameter {name}'
