@@ -40,7 +40,7 @@ def main():
     values = dict(config.DEFAULTS)
     for item in args.set:
         name, text = item.split('=', 1)
-        values[name] = type(config.DEFAULTS[name])(text)
+        values[name] = config.parse_value(name, text)
     detector = config.build_detector(values)
     scene = synthetic_scene(n_frames=60, shape=(480, 640), seed=3)
     frames = list(scene.frames) * 6                      # 360 frames: the window fills up

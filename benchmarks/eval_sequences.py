@@ -37,14 +37,6 @@ SEQUENCES = ('sbi_IBMtest2', 'sbi_CAVIAR2', 'sbi_CAVIAR1', 'sbi_Candela_m1.10', 
 RECALL_TOOL = DATA.parent / 'tools' / 'object_recall.py'
 
 
-def parse_value(name, text):
-    """Convert ``text`` to the type of parameter ``name``'s default."""
-    default = config.DEFAULTS[name]
-    if isinstance(default, bool):
-        return text.lower() in ('1', 'true', 'yes')
-    return type(default)(text)
-
-
 def mask_name(dataset, index):
     """
     Name frame ``index``'s mask with its ground truth's number (``gt000000`` -> ``bin000000``).
@@ -98,7 +90,7 @@ def main(argv=None):
     values = dict(config.DEFAULTS)
     for item in args.set:
         name, text = item.split('=', 1)
-        values[name] = parse_value(name, text)
+        values[name] = config.parse_value(name, text)
     rows = []
     for path in args.datasets:
         row = score_dataset(path, values, args.mode, args.masks)

@@ -392,8 +392,10 @@ def inert_reason(name, values, context):
 
 
 def inert_parameters(values, names, context):
-    """Return ``{name: reason}`` for those of ``names`` that have no effect under ``values``."""
-    reasons = {name: inert_reason(name, values, context) for name in names if name in BY_NAME}
+    """Return ``{name: reason}`` for those of ``names`` that have no effect, in table order."""
+    names = set(names)
+    reasons = {spec.name: inert_reason(spec.name, values, context) for spec in PARAMETERS
+               if spec.name in names}
     return {name: reason for name, reason in reasons.items() if reason is not None}
 
 

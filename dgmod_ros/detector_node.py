@@ -56,7 +56,7 @@ _WARN_PERIOD = 5.0
 
 
 def _descriptor(spec):
-    descriptor = ParameterDescriptor(description=spec.description, read_only=spec.read_only)
+    descriptor = ParameterDescriptor(description=config.describe(spec), read_only=spec.read_only)
     if spec.choices:
         descriptor.additional_constraints = 'one of: ' + ', '.join(spec.choices)
     elif isinstance(spec.default, bool):
@@ -79,11 +79,17 @@ class DetectorNode(LifecycleNode):
 
     def __init__(self, **kwargs):
         super().__init__('detector', **kwargs)
-        for spec in config.PARAMETERS:
+        # Only what the node reads; the offline-only ones (max_iter) keep their defaults.
+        self._values = dict(config.DEFAULTS)
+        for spec in config.reads(config.NODE):
             self.declare_parameter(spec.name, spec.default, _descriptor(spec))
-        self._values = {spec.name: self.get_parameter(spec.name).value
-                        for spec in config.PARAMETERS}
+            self._values[spec.name] = self.get_parameter(spec.name).value
         config.validate(self._values)       # a bad parameter file stops the node here
+        self._warn_inert(self._values, self._values_set(self._values))
+        for name in getattr(self, '_parameter_overrides', {}):   # rclpy keeps the overrides
+            if name in config.BY_NAME and not self.has_parameter(name):
+                reason = config.inert_reason(name, self._values, config.NODE)
+                self.get_logger().warning(f'{name} is not a node parameter: {reason}')
         self._lock = threading.Lock()       # guards the detector between callbacks
         self._stats = DetectorStats()
         self._detector = None               # built by configure
@@ -363,7 +369,8 @@ class DetectorNode(LifecycleNode):
         changed = {p.name: p.value for p in parameters if p.name in config.BY_NAME}
         if not changed:
             return
-        values = dict(self._values)
+        previous = self._values
+        values = dict(previous)
         values.update(changed)
         with self._lock:
             if self._detector is not None:     # unconfigured: configure builds it
@@ -374,6 +381,18 @@ class DetectorNode(LifecycleNode):
         self._apply_node_parameters()
         self.get_logger().info('parameters changed: ' + ', '.join(
             f'{name}={value}' for name, value in sorted(changed.items())))
+        # The changed ones that do nothing, and those set before that this change made inert.
+        before = config.inert_parameters(previous, self._values_set(previous), config.NODE)
+        self._warn_inert(values, set(changed) | (self._values_set(values) - set(before)))
+
+    @staticmethod
+    def _values_set(values):
+        return {spec.name for spec in config.reads(config.NODE)
+                if values[spec.name] != spec.default}
+
+    def _warn_inert(self, values, names):
+        for name, reason in config.inert_parameters(values, names, config.NODE).items():
+            self.get_logger().warning(f'{name}={values[name]} has no effect: {reason}')
 
     def _apply_node_parameters(self):
         configured = self._mask_pub is not None

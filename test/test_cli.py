@@ -9,7 +9,7 @@ import threading
 
 from bags import write_image_bag
 import cv2
-from dgmod_ros import cli
+from dgmod_ros import cli, config
 from dgmod_ros.core.metrics import iou
 from dgmod_ros.core.runtime import IO_THREAD_NICENESS
 from dgmod_ros.core.synthetic import synthetic_scene
@@ -156,6 +156,124 @@ def test_existing_output_is_not_overwritten_without_force(tmp_path, scene, capsy
     out.mkdir()
     assert run('separate', folder, '--out', out) == 2
     assert 'exists' in capsys.readouterr().err
+
+
+# Every boolean option of both commands, from the table: a new one is covered by itself.
+BOOLEANS = [(command, spec.name) for command in ('separate', 'evaluate')
+            for spec in cli.offline_parameters(command) if isinstance(spec.default, bool)]
+TRUE_FORMS = [[], ['true'], ['True'], ['yes'], ['on'], ['1']]
+FALSE_FORMS = [['false'], ['FALSE'], ['no'], ['off'], ['0']]
+
+
+def parse(command, *options):
+    head = ['separate', 'input'] if command == 'separate' else ['evaluate', 'dataset']
+    return cli.build_parser().parse_args(head + ['--out', 'out'] + list(options))
+
+
+def test_the_boolean_table_is_every_boolean_offline_parameter():
+    offline = {spec.name for spec in config.PARAMETERS
+               if isinstance(spec.default, bool) and spec.where != 'node'}
+    assert offline and {name for _, name in BOOLEANS} == offline
+    assert {command for command, _ in BOOLEANS} == {'separate', 'evaluate'}
+
+
+@pytest.mark.parametrize('command, name', BOOLEANS)
+def test_boolean_options_take_what_a_user_types(command, name):
+    option = cli.option_name(name)
+    assert cli.resolve_parameters(parse(command))[0][name] is config.DEFAULTS[name]
+    for words, expected in [(w, True) for w in TRUE_FORMS] + [(w, False) for w in FALSE_FORMS]:
+        for argv in ([option] + words, [f'{option}={words[0]}'] if words else [option]):
+            values, given = cli.resolve_parameters(parse(command, *argv))
+            assert values[name] is expected, argv
+            assert given[name] == option
+    assert cli.resolve_parameters(parse(command, '--no-' + option[2:]))[0][name] is False
+    # The last one given wins, as for any option.
+    assert cli.resolve_parameters(parse(command, option, 'no', option))[0][name] is True
+
+
+@pytest.mark.parametrize('command, name', BOOLEANS)
+@pytest.mark.parametrize('word', ['maybe', 'flase', '2', ''])
+def test_anything_else_is_refused_in_one_line(command, name, word, capsys):
+    option = cli.option_name(name)
+    with pytest.raises(SystemExit) as stop:
+        parse(command, f'{option}={word}')
+    assert stop.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count('\n') == 1 and option in err and repr(word) in err
+    assert err.startswith(f'dgmod {command}: error: argument {option}: expected true or false')
+
+
+def test_a_boolean_given_false_runs_false_end_to_end(tmp_path, scene):
+    folder = write_folder(tmp_path / 'seq', scene.frames[:8])
+    assert run('separate', folder, '--out', tmp_path / 'out', '--window', 5, '--stride', 5,
+               '--conditional-update', 'false', '--no-ghost-test') == 0
+    parameters = json.loads((tmp_path / 'out' / 'report.json').read_text())['parameters']
+    assert parameters['conditional_update'] is False and parameters['ghost_test'] is False
+
+
+def test_booleans_in_a_parameter_file_must_be_booleans(tmp_path, capsys):
+    params = tmp_path / 'p.yaml'
+    params.write_text('/detector:\n  ros__parameters:\n    ghost_test: false\n')
+    assert cli.resolve_parameters(parse('separate', '--config', str(params)))[0][
+        'ghost_test'] is False
+    params.write_text('/detector:\n  ros__parameters:\n    ghost_test: maybe\n')
+    assert run('separate', tmp_path, '--out', tmp_path / 'o', '--config', params) == 2
+    err = capsys.readouterr().err
+    assert err == 'dgmod: error: ghost_test must be true or false, got ' + repr('maybe') + '\n'
+
+
+@pytest.mark.parametrize('command', ['separate', 'evaluate'])
+def test_one_option_per_parameter_and_none_twice(command):
+    parser = cli.build_parser()
+    sub = parser._subparsers._group_actions[0].choices[command]
+    options = [o for action in sub._actions for o in action.option_strings]
+    assert len(options) == len(set(options))
+    dests = {action.dest for action in sub._actions if action.help != '==SUPPRESS=='}
+    offered = {spec.name for spec in cli.offline_parameters(command)}
+    assert offered <= dests
+    assert not {spec.name for spec in config.PARAMETERS if spec.where == 'node'} & dests
+    assert ('method' in dests) == (command == 'separate')     # evaluate has --methods
+
+
+def test_the_removed_threshold_option_names_its_successor(capsys):
+    with pytest.raises(SystemExit) as stop:
+        parse('separate', '--threshold', '0.2')
+    err = capsys.readouterr().err
+    assert stop.value.code == 2 and err.count('\n') == 1 and 'use --mask-threshold' in err
+
+
+def test_help_groups_the_advanced_parameters_apart(capsys):
+    with pytest.raises(SystemExit):
+        parse('separate', '--help')
+    text = capsys.readouterr().out
+    basic, advanced = text.split(config.ADVANCED_TITLE.split(' (')[0])
+    for spec in cli.offline_parameters('separate'):
+        assert cli.option_name(spec.name) + ' ' in (advanced if spec.advanced else basic)
+    assert '--max-iter' in advanced and '[batch]' in advanced.split('--max-iter')[1][:300]
+    assert 'Acts only with decision=global' in ' '.join(basic.split())
+
+
+def test_a_parameter_that_does_nothing_is_one_warning(tmp_path, scene, capsys):
+    folder = write_folder(tmp_path / 'seq', scene.frames[:8])
+    assert run('separate', folder, '--out', tmp_path / 'a', '--window', 5, '--stride', 5,
+               '--mask-k', 4, '--max-iter', 20) == 0
+    err = [line for line in capsys.readouterr().err.splitlines() if 'warning' in line]
+    assert err == ['dgmod: warning: --max-iter has no effect: it is read only by dgmod '
+                   '--mode batch',                  # one line each, in the table's order
+                   'dgmod: warning: --mask-k has no effect: it acts only with decision=global '
+                   'and mask_threshold=0.0 (decision is adaptive, mask_threshold is 0.0)']
+    assert run('separate', folder, '--out', tmp_path / 'b', '--window', 5, '--stride', 5,
+               '--mask-k', 4, '--decision', 'global') == 0
+    assert 'warning' not in capsys.readouterr().err
+
+
+def test_evaluate_warns_of_a_parameter_no_method_reads(capsys):
+    values, given = cli.resolve_parameters(parse('evaluate', '--lambda2', '0.3'))
+    cli.warn_inert(values, given, 'stream', ['dgmod', 'median'])
+    assert capsys.readouterr().err == ''
+    cli.warn_inert(values, given, 'stream', ['median', 'mog2'])
+    assert capsys.readouterr().err == ('dgmod: warning: --lambda2 has no effect: it acts only '
+                                       'with method=dgmod (method is median)\n')
 
 
 @pytest.mark.skipif(not sys.platform.startswith('linux'), reason='per-thread nice values: Linux')

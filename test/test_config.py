@@ -170,8 +170,11 @@ def short_stream():
     return [Frame(index, f'{index:06d}', frame, 'rgb') for index, frame in enumerate(scene.frames)]
 
 
-@pytest.mark.parametrize('choice', _CHOICES, ids=lambda c: ','.join(f'{k}={v}' for k, v in
-                                                                      c.items()) or 'defaults')
+def _choice_id(choice):
+    return ','.join(f'{name}={value}' for name, value in choice.items()) or 'defaults'
+
+
+@pytest.mark.parametrize('choice', _CHOICES, ids=_choice_id)
 def test_what_the_table_calls_inert_leaves_the_masks_unchanged(choice, short_stream):
     values = config.validate(dict(config.DEFAULTS, window=12, stride=4, memory_spacing=1,
                                   **choice))
