@@ -481,16 +481,21 @@ def detector_class(values):
     return OpenCVSubtractor if values['method'] in _OPENCV_METHODS else SlidingWindowDetector
 
 
-def load_kernels(values):
+def load_kernels(values, log=None, pending=None, should_stop=None):
     """
     Load the compiled kernels that ``values['method']`` runs (numba's disk cache).
 
     Once per process: a start-up cost like the imports. Loaded lazily, they
     would stall the first frame (the node lost the frames after its first to
     its input queue meanwhile: docs/node.md), and a caller timing the frames
-    would count them. OpenCV's subtractors need none.
+    would count them. OpenCV's subtractors need none. A cache not ready for
+    this install is filled by a child process first (``pending``, if one was
+    started already), which ``log`` announces and a signal or
+    ``should_stop()`` interrupts (:func:`~dgmod_ros.core.kernel_cache.ensure_ready`).
     """
     if detector_class(values) is SlidingWindowDetector:
+        from .core.kernel_cache import ensure_ready
+        ensure_ready(log, pending, should_stop)
         from .core.kernels import compile_all       # numba: imported when needed
         compile_all()
 

@@ -77,8 +77,11 @@ class StartupError(RuntimeError):
 class DetectorNode(LifecycleNode):
     """ROS wiring around :mod:`dgmod_ros.core`'s streaming detector, as a lifecycle node."""
 
-    def __init__(self, **kwargs):
+    def __init__(self, kernel_compile=None, **kwargs):
         super().__init__('detector', **kwargs)
+        # A compile of the kernels main() started before its imports, if the
+        # cache was cold (core.kernel_cache): configure waits for it.
+        self._kernel_compile = kernel_compile
         # Only what the node reads; the offline-only ones (max_iter) keep their defaults.
         self._values = dict(config.DEFAULTS)
         for spec in config.reads(config.NODE):
@@ -131,7 +134,11 @@ class DetectorNode(LifecycleNode):
         except ValueError as error:
             self.get_logger().error(f'configure failed: {error}')
             return TransitionCallbackReturn.FAILURE
-        config.load_kernels(self._values)      # before the first frame, not in its callback
+        # Before the first frame, not in its callback; a cold cache is filled
+        # by a child process while this thread waits, stoppable (docs/node.md).
+        pending, self._kernel_compile = self._kernel_compile, None
+        config.load_kernels(self._values, self.get_logger().info, pending,
+                            should_stop=lambda: not self.context.ok())
         keep_freed_memory()     # the solves' large temporaries reused, not mapped afresh
         with self._lock:
             self._detector = detector
@@ -477,12 +484,15 @@ class DetectorNode(LifecycleNode):
         return super().destroy_node()
 
 
-def main(args=None):
+def main(args=None, kernel_compile=None):
     """
     Run the detector until Ctrl-C, SIGTERM or an external shutdown.
 
     Returns the exit status: 0, or 1 when a parameter given at start-up is
     invalid (one logged error naming it and the reason, no traceback).
+    ``kernel_compile``: a compile of the kernels already started
+    (:mod:`dgmod_ros.detector_entry`, the installed ``detector``), ended
+    with the process.
     """
     # Jazzy's rclpy.init() returns None (the context-manager form arrived after
     # Jazzy), so the context is shut down in a finally block instead.
@@ -490,7 +500,7 @@ def main(args=None):
     node = None
     try:
         try:
-            node = DetectorNode()
+            node = DetectorNode(kernel_compile=kernel_compile)
         except (ParameterException, ValueError) as error:
             # Out of range or of the wrong type (rclpy), or against a
             # cross-field rule (config.validate): the messages name the parameter.
@@ -498,7 +508,9 @@ def main(args=None):
                 f'invalid parameter, detector not started: {error}')
             return 1
         except StartupError:
-            return 1            # the failed transition logged its reason
+            # The failed transition logged its reason, unless a signal
+            # stopped the start (a kernel compile interrupted): a normal stop.
+            return 1 if rclpy.ok() else 0
         # The solves run in the node's own thread, so the executor only carries
         # short callbacks. rclpy's MultiThreadedExecutor lost frames of a
         # 30 frames/s replay here (queue overflow during its stalls; rclpy#1452,
@@ -514,6 +526,8 @@ def main(args=None):
         if rclpy.ok():
             raise
     finally:
+        if kernel_compile is not None:
+            kernel_compile.stop()
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()

@@ -39,7 +39,9 @@ Import side effects, all process-wide and made before the first compiled call:
 - ``NUMBA_CACHE_DIR`` defaults to ``$XDG_CACHE_HOME/dgmod_ros/numba`` (else
   ``~/.cache/dgmod_ros/numba``) when unset, so an installed package in a
   read-only prefix still loads its compiled kernels from disk instead of
-  compiling them at every start;
+  compiling them at every start; the kernels an install compiled (colcon
+  build) are copied there first where missing
+  (:mod:`~dgmod_ros.core.kernel_cache`);
 - ``numba.config.THREADING_LAYER = 'threadsafe'``: the node calls kernels from
   its image callback and its solve thread at once, and numba's ``workqueue``
   fallback stops the process when two threads enter it. ``threadsafe`` makes
@@ -50,17 +52,14 @@ Import side effects, all process-wide and made before the first compiled call:
 """
 
 import os
-from pathlib import Path
+import sys
+import time
 
-
-def default_cache_dir():
-    """Return the folder for numba's compiled-kernel cache (see module docstring)."""
-    base = os.environ.get('XDG_CACHE_HOME') or str(Path.home() / '.cache')
-    return str(Path(base) / 'dgmod_ros' / 'numba')
-
+from .kernel_cache import default_cache_dir, mark_ready, seed_cache
 
 if not os.environ.get('NUMBA_CACHE_DIR'):
     os.environ['NUMBA_CACHE_DIR'] = default_cache_dir()
+seed_cache()
 # Also in the environment: numba re-reads its whole configuration from the
 # environment when that changed since its import (the line above does, when
 # another module imported numba first), which would reset an attribute set alone.
@@ -391,10 +390,28 @@ def compile_all():
     """
     Compile (or load from the cache) every kernel by running it on a tiny window.
 
-    A cold compile takes tens of seconds on a small machine and holds the GIL;
-    run this once after installing (``python3 -c 'from dgmod_ros.core.kernels
-    import compile_all; compile_all()'``) so the node starts from the cache.
+    A cold compile takes tens of seconds on a small machine and holds the
+    GIL: ``colcon build`` runs this at install time, and a process that finds
+    the cache cold runs it in a child
+    (:func:`~dgmod_ros.core.kernel_cache.compile_in_child`), then here to
+    load. At the end the cache is marked ready for this install, with the
+    compile's seconds where anything was compiled.
     """
+    start = time.monotonic()
+    _compile_every_kernel()
+    compiled = any(sum(dispatcher.stats.cache_misses.values())
+                   for dispatcher in _dispatchers())
+    mark_ready(time.monotonic() - start if compiled else None)
+
+
+def _dispatchers():
+    from numba.core.registry import CPUDispatcher
+    return [value for name, module in list(sys.modules.items())
+            if name.startswith(__package__.split('.')[0]) and module is not None
+            for value in vars(module).values() if isinstance(value, CPUDispatcher)]
+
+
+def _compile_every_kernel():
     from .dgmod import DualGraphMOD
     data = np.linspace(0.0, 1.0, 12 * 4, dtype=np.float32).reshape(12, 4)
     DualGraphMOD(max_iter=1).fit(data, (3, 4))
