@@ -27,7 +27,7 @@ import time
 import cv2
 
 from . import config
-from .config import BATCH, STREAM
+from .config import BATCH, OFFLINE, STREAM
 from .core.preprocess import to_uint8
 from .core.runtime import keep_freed_memory, yield_to_compute
 from .evaluation import evaluate
@@ -124,7 +124,8 @@ def _add_parameter_options(parser, command):
             option = option_name(spec.name)
             tag = _MODE_TAGS[tuple(c for c in (STREAM, BATCH) if c in spec.acts)]
             kwargs = {'dest': spec.name, 'default': None,
-                      'help': (config.describe(spec) + tag).replace('%', '%%')}
+                      'help': (config.describe(spec, OFFLINE) + tag).replace(
+                          '%', '%%')}
             if isinstance(spec.default, bool):
                 group.add_argument(option, action=_BooleanValue, nargs='?', metavar='BOOL',
                                    **kwargs)

@@ -350,16 +350,26 @@ def _condition_text(name, allowed):
     return f'{name}={"|".join(map(_text, allowed))}'
 
 
-def conditions_text(spec):
-    """Return ``spec.active_when`` in words ('decision=global and mask_threshold=0.0'), or ''."""
+def conditions_text(spec, contexts=EVERYWHERE):
+    """
+    Return ``spec.active_when`` in words ('decision=global and mask_threshold=0.0'), or ''.
+
+    Only the conditions on parameters read in one of ``contexts``: the command
+    line does not mention the node's ``solve_mode``.
+    """
+    alternatives = [[(name, allowed) for name, allowed in alternative
+                     if set(BY_NAME[name].acts) & set(contexts)]
+                    for alternative in spec.active_when]
+    if not all(alternatives):           # one alternative always holds there
+        return ''
     return ', or with '.join(' and '.join(_condition_text(name, allowed)
                                           for name, allowed in alternative)
-                             for alternative in spec.active_when)
+                             for alternative in alternatives)
 
 
-def describe(spec):
+def describe(spec, contexts=EVERYWHERE):
     """Return the description the node, the YAML file and ``--help`` show: when it acts too."""
-    conditions = conditions_text(spec)
+    conditions = conditions_text(spec, contexts)
     if not conditions:
         return spec.description
     return f'{spec.description.rstrip(".")}. Acts only with {conditions}.'
@@ -626,7 +636,8 @@ def _commented(spec, indent):
     import textwrap
     allowed = (' {' + ', '.join(spec.choices) + '}' if spec.choices
                else f' [{spec.low}, {spec.high}]' if spec.low is not None else '')
-    return [f'{indent}# ' + line for line in textwrap.wrap(describe(spec) + allowed, 88)]
+    text = describe(spec, NODE_ONLY if NODE in spec.acts else OFFLINE)
+    return [f'{indent}# ' + line for line in textwrap.wrap(text + allowed, 88)]
 
 
 def parameter_file_text():

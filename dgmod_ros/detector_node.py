@@ -56,7 +56,8 @@ _WARN_PERIOD = 5.0
 
 
 def _descriptor(spec):
-    descriptor = ParameterDescriptor(description=config.describe(spec), read_only=spec.read_only)
+    descriptor = ParameterDescriptor(description=config.describe(spec, config.NODE_ONLY),
+                                     read_only=spec.read_only)
     if spec.choices:
         descriptor.additional_constraints = 'one of: ' + ', '.join(spec.choices)
     elif isinstance(spec.default, bool):
