@@ -23,7 +23,7 @@ class install_kernels(Command):
     the first start then compiles in a child process.
     """
 
-    description = 'compile the installed package\'s numba kernels into its kernel seed'
+    description = "compile the installed package's numba kernels into its kernel seed"
     user_options = []
 
     def initialize_options(self):

@@ -21,7 +21,7 @@ def _interrupt(signum, frame):
 
 
 def main(args=None):
-    """Run the detector (:func:`dgmod_ros.detector_node.main`), its kernel compile started first."""
+    """Run the detector (:func:`dgmod_ros.detector_node.main`), its kernels compiling first."""
     from rclpy.logging import get_logger
 
     from .core.kernel_cache import start_compile
@@ -31,7 +31,7 @@ def main(args=None):
     # Ctrl-C does, so the child is ended too.
     previous = signal.signal(signal.SIGTERM, _interrupt)
     try:
-        pending = start_compile(get_logger('detector').info)
+        pending = start_compile(get_logger('detector').info, say_ready=True)
         from .detector_node import main as run_node
     except KeyboardInterrupt:
         if pending is not None:

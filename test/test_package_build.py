@@ -85,8 +85,8 @@ def test_installed_detector_masks_frames_and_stops_cleanly(install, monkeypatch,
         node.create_subscription(Image, 'foreground_mask', masks.append, QoSProfile(depth=50))
         publisher = node.create_publisher(Image, 'image', QoSProfile(depth=10))
         frames = synthetic_scene(n_frames=20, shape=(48, 64)).frames
-        # A fresh install compiles the kernels when it configures (numba's
-        # cache is per installed file): about 30 s on two cores.
+        # The install compiled the kernels (numba's cache is per installed
+        # file); a slow machine may still take a while to load them.
         deadline = time.monotonic() + 90
         index = 0
         while len(masks) < 3 and time.monotonic() < deadline:
@@ -107,3 +107,36 @@ def test_installed_detector_masks_frames_and_stops_cleanly(install, monkeypatch,
     assert 'detector ready' in output
     assert process.returncode == 0, output
     assert 'Traceback' not in output, output
+
+
+def test_the_install_compiled_the_kernels_and_a_fresh_home_loads_them(install, tmp_path):
+    from dgmod_ros.core import kernel_cache
+    package = next((install / 'lib').glob('python3*/site-packages')) / 'dgmod_ros'
+    seed = package / kernel_cache.SEED_NAME
+    assert kernel_cache.is_ready(seed, package)           # for the installed files
+    assert list(seed.rglob('*.nbi')) and list(seed.rglob('*.nbc'))
+    # A new user: empty home, no cache setting. The detector copies the seed
+    # and loads it; nothing is compiled at start-up.
+    env = _environment(install, random.randint(120, 200))
+    env.pop('NUMBA_CACHE_DIR', None)
+    env.pop('XDG_CACHE_HOME', None)
+    env['HOME'] = str(tmp_path)
+    process = subprocess.Popen([str(install / 'lib' / 'dgmod_ros' / 'detector')], env=env,
+                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    lines = []
+    try:
+        for line in process.stdout:
+            lines.append(line)
+            if 'detector ready' in line:
+                break
+        process.send_signal(signal.SIGINT)
+        output, _ = process.communicate(timeout=30)
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+    output = ''.join(lines) + output
+    assert 'loading them from ' + str(tmp_path / '.cache' / 'dgmod_ros' / 'numba') in lines[0]
+    assert 'detector ready' in output and 'compiling kernels' not in output, output
+    assert kernel_cache.is_ready(tmp_path / '.cache' / 'dgmod_ros' / 'numba', package)
+    assert process.returncode == 0 and 'Traceback' not in output, output

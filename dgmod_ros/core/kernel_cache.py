@@ -114,13 +114,15 @@ def _copy_if_newer(source, destination):
 
 
 def _host_cpu():
-    # What numba's cache keys an entry by besides the source (its codegen's
-    # magic tuple); llvmlite comes with numba and loads in a fraction of a second.
+    # numba's cache keys an entry by the CPU too (its codegen's name and
+    # features): the processor's model and flags change with them, read
+    # without loading LLVM.
     try:
-        from llvmlite import binding
-        return [binding.get_host_cpu_name(), binding.get_host_cpu_features().flatten()]
-    except Exception:  # noqa: B902 - no llvmlite: the key still holds the sources
-        return [platform.machine()]
+        with open('/proc/cpuinfo') as info:
+            fields = dict(map(str.strip, line.split(':', 1)) for line in info if ':' in line)
+        return [fields.get('model name', ''), fields.get('flags', '')]
+    except OSError:
+        return [platform.machine(), platform.processor()]
 
 
 def _numba_version():
@@ -236,7 +238,7 @@ class ChildCompile:
 
     @property
     def pid(self):
-        """The child's process id."""
+        """Return the child's process id."""
         return self._child.pid
 
     def wait(self, progress=None, should_stop=None, poll=0.1, report_every=10.0):
@@ -277,20 +279,27 @@ class ChildCompile:
                 self._child.wait()
 
 
-def start_compile(log=None):
+def start_compile(log=None, say_ready=False):
     """
     Start a :class:`ChildCompile` unless the cache is ready for this install; say so.
 
     Copies the install's seed first (:func:`seed_cache`). Returns the
-    compile, or None when there is nothing to compile.
+    compile, or None when there is nothing to compile (``log``ged too with
+    ``say_ready``).
     """
     seed_cache()
     if is_ready():
+        if log is not None and say_ready:
+            log(f'starting: kernels compiled for this install, loading them from {cache_dir()}')
         return None
     compile_ = ChildCompile()
-    if log is not None:
-        log(f'compiling kernels, once per install, about {expected_compile_seconds():.0f} s '
-            f'(numba cache {cache_dir()}); Ctrl-C stops it')
+    try:
+        if log is not None:
+            log(f'compiling kernels, once per install, about {expected_compile_seconds():.0f} s '
+                f'(numba cache {cache_dir()}); Ctrl-C stops it')
+    except BaseException:
+        compile_.stop()         # a signal before the caller holds the child
+        raise
     return compile_
 
 
@@ -320,7 +329,7 @@ def ensure_ready(log=None, pending=None, should_stop=None):
 
 
 def main():
-    """Compile (or load) every kernel into the cache and write the ready mark (the child's body)."""
+    """Compile (or load) every kernel into the cache, then mark it ready (the child's body)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     from .kernels import compile_all
     compile_all()

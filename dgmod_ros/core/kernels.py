@@ -65,7 +65,7 @@ seed_cache()
 # another module imported numba first), which would reset an attribute set alone.
 os.environ.setdefault('NUMBA_THREADING_LAYER', 'threadsafe')
 
-import numba  # noqa: E402 (the cache folder must be set before numba reads its config)
+import numba  # noqa: E402, I100 (the cache folder must be set before numba reads its config)
 from numba import njit, prange  # noqa: E402
 from numba.typed import List  # noqa: E402
 import numpy as np  # noqa: E402
