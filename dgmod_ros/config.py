@@ -200,12 +200,12 @@ PARAMETERS = (
     Parameter('cloud_pixel_step', 2, 'foreground_points takes every n-th pixel in both '
               'directions (1 = every foreground pixel)', 1, 16, node_only=True),
     # Depth background and fusion (issue 23): depth decides where it can tell.
-    Parameter('depth_background', True, 'learn the static scene\'s depth per pixel and decide '
+    Parameter('depth_background', True, "learn the static scene's depth per pixel and decide "
               'with it: nearer by more than depth_noise_k noise levels is foreground, at its '
               'depth background, whatever the colour says; no reading: the colour mask. '
               'false: the colour mask back-projected as it is', node_only=True),
     Parameter('depth_fuse_mask', True, 'foreground_mask carries the fused mask too (published '
-              'when the frame\'s depth partner arrives; at once while no depth comes)',
+              "when the frame's depth partner arrives; at once while no depth comes)",
               node_only=True),
     Parameter('depth_only', False, 'no colour subscription: masks, points and masked depth '
               'from the depth background alone (a dark scene, a depth-only sensor)',
@@ -217,9 +217,9 @@ PARAMETERS = (
               '(1/m); 0.004 for a RealSense D435 at 640 x 480 (subpixel 0.08, 50 mm baseline), '
               'about half for a 95 mm baseline', 0.0, 1.0, node_only=True),
     Parameter('depth_noise_k', 4.0, 'multiple of the depth noise that makes a pixel nearer '
-              'than the static scene (foreground); within it, at the scene\'s depth',
+              "than the static scene (foreground); within it, at the scene's depth",
               0.5, 100.0, node_only=True),
-    Parameter('depth_learn_frames', 10, 'readings at the scene\'s depth before a pixel\'s depth '
+    Parameter('depth_learn_frames', 10, "readings at the scene's depth before a pixel's depth "
               'decides (until then the colour mask does)', 1, 100000, node_only=True),
     Parameter('depth_reveal_frames', 5, 'consistent readings behind the learnt depth that move '
               'it back (the scene uncovered by what stood there)', 1, 100000, node_only=True),

@@ -291,7 +291,7 @@ class DetectorNode(LifecycleNode):
         self._watch_foreground_share(mask)
 
     def _on_depth_scene_change(self):
-        """The depth background restarted (camera moved): restart the window too."""
+        """Restart the window: the depth background restarted (the camera moved)."""
         with self._lock:
             if self._detector is not None:
                 self._detector.reset()

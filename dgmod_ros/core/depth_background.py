@@ -184,6 +184,10 @@ class DepthBackground:
             nearer = offset < -margin
             behind = offset > margin
             match = np.abs(offset) <= margin
+            # Learnt from the readings within half the band only: a person just
+            # in front of the wall, whose noise reaches into the band now and
+            # then, would otherwise pull the mean, and the band, towards them.
+            close = np.abs(offset) <= np.float32(0.5) * margin
         valid = np.isfinite(depth)
         trusted = self.hits_ >= np.float32(self.learn_frames)
         verdict = np.zeros(depth.shape, np.uint8)
@@ -198,11 +202,11 @@ class DepthBackground:
             self._learn(depth, none, valid, none, none)
             return np.zeros(depth.shape, np.uint8)
         first = valid & np.isnan(background)
-        self._learn(depth, match, first, nearer, behind)
+        self._learn(depth, close, first, nearer, behind)
         return verdict
 
     def _learn(self, depth, match, first, nearer, behind):
-        """Update the model from one image given each pixel's relation to it."""
+        """Update the model from one image: ``match`` the readings it learns from."""
         background, hits = self.background_, self.hits_
         self.frames_ += 1
         # At the scene's depth: a running mean over up to span_frames readings.
@@ -241,7 +245,9 @@ class DepthBackground:
         revealed = frames >= self.reveal_frames
         if revealed.any():
             np.copyto(self.background_, far, where=revealed)
-            np.copyto(self.hits_, frames.astype(np.float32), where=revealed)
+            # Trusted at once: the scene's far side, seen reveal_frames times.
+            np.copyto(self.hits_, np.maximum(frames, self.learn_frames).astype(np.float32),
+                      where=revealed)
             self.near_frames_[revealed] = 0
             frames[revealed] = 0
 
