@@ -169,3 +169,26 @@ def test_invalid_settings_are_refused(change, message):
         DepthBackground(**change).validate()
     with pytest.raises(ValueError, match=r'\(h, w\)'):
         DepthBackground().update(np.zeros((2, 2, 3), np.float32))
+
+
+def test_the_compiled_passes_equal_their_numpy_reference_bit_for_bit():
+    # Walks in, stands, leaves; noise, speckle, patches; absorb and reveal both happen.
+    scene = WalkAndStop(shape=SHAPE, walk_frames=10, empty_frames=12, noise_base=0.002,
+                        noise_quadratic=0.005, invalid_fraction=0.05, invalid_patches=True)
+    settings = {'absorb_frames': 25, 'learn_frames': 4, 'reveal_frames': 3}
+    compiled = DepthBackground(**settings)
+    reference = DepthBackground(**settings, compiled=False)
+    moved = None
+    for t in range(90):
+        _, depth, _ = scene.frame(t)
+        if t >= 60:
+            depth = np.full(SHAPE, 3.0, np.float32)       # the person left
+        if t >= 80:
+            moved = depth = np.full(SHAPE, 4.0, np.float32)    # the camera moved
+        verdicts = [model.update(depth) for model in (compiled, reference)]
+        assert np.array_equal(verdicts[0], verdicts[1]), t
+        for name in ('background_', 'hits_', 'near_frames_', '_far_depth', '_far_frames'):
+            assert np.array_equal(getattr(compiled, name), getattr(reference, name),
+                                  equal_nan=True), (t, name)
+    assert moved is not None and compiled.scene_changes_ == reference.scene_changes_ == 1
+    assert (verdicts[0] == BACKGROUND).mean() > 0.9

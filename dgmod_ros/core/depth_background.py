@@ -25,6 +25,8 @@ fixed number of subpixels makes depth noise grow with z squared).
 
 import numpy as np
 
+from . import depth_kernel
+
 #: Verdicts of :meth:`DepthBackground.update`, one uint8 per pixel.
 UNKNOWN, BACKGROUND, FOREGROUND = np.uint8(0), np.uint8(1), np.uint8(2)
 # A scene change is judged only on a frame with this share of trusted readings.
@@ -70,6 +72,9 @@ class DepthBackground:
         Share of the trusted pixels with a reading that, behind the model in
         one frame, restarts it (the camera moved: a person can hide the scene
         but never put it farther away); 1.0 disables.
+    compiled : bool, default=True
+        Run the update as two compiled passes (:mod:`dgmod_ros.core.depth_kernel`);
+        False runs its numpy reference (the same results, bit for bit).
 
     Attributes
     ----------
@@ -94,7 +99,7 @@ class DepthBackground:
 
     def __init__(self, noise_base=0.002, noise_quadratic=0.005, noise_k=4.0,
                  absorb_frames=300, learn_frames=10, reveal_frames=5, span_frames=300,
-                 change_fraction=0.25):
+                 change_fraction=0.25, compiled=True):
         self.noise_base = noise_base
         self.noise_quadratic = noise_quadratic
         self.noise_k = noise_k
@@ -103,6 +108,7 @@ class DepthBackground:
         self.reveal_frames = reveal_frames
         self.span_frames = span_frames
         self.change_fraction = change_fraction
+        self.compiled = compiled
         self.scene_changes_ = 0
         self.reset()
 
@@ -175,59 +181,81 @@ class DepthBackground:
             raise ValueError(f'expected an (h, w) depth image, got shape {depth.shape}')
         if self.background_ is None or self.background_.shape != depth.shape:
             self._start(depth.shape)
-        k = np.float32(self.noise_k)
-        background = self.background_
+        depth = np.require(depth, np.float32, 'CW')     # the compiled passes' one layout
+        judge = self._judge_compiled if self.compiled else self._judge_numpy
+        verdict, judged, behind = judge(depth)
+        if self.change_fraction < 1 and judged >= _FEWEST_JUDGED * depth.size \
+                and behind > self.change_fraction * judged:
+            self.scene_changes_ += 1
+            self._start(depth.shape)          # and learnt from this image on
+            verdict[:] = UNKNOWN
+        self.frames_ += 1
+        (self._learn_compiled if self.compiled else self._learn_numpy)(depth)
+        return verdict
+
+    def _scalars(self):
+        return (np.float32(self.noise_k), np.float32(self.noise_base),
+                np.float32(self.noise_quadratic))
+
+    def _judge_compiled(self, depth):
+        verdict = np.empty(depth.shape, np.uint8)
+        judged, behind = depth_kernel.judge(
+            depth.reshape(-1), self.background_.reshape(-1), self.hits_.reshape(-1),
+            *self._scalars(), np.float32(self.learn_frames), verdict.reshape(-1))
+        return verdict, judged, behind
+
+    def _learn_compiled(self, depth):
+        depth_kernel.learn(depth.reshape(-1), self.background_.reshape(-1),
+                           self.hits_.reshape(-1), self.near_frames_.reshape(-1),
+                           self._far_depth.reshape(-1), self._far_frames.reshape(-1),
+                           *self._scalars(), np.float32(self.span_frames),
+                           int(self.absorb_frames), int(self.learn_frames),
+                           int(self.reveal_frames))
+
+    # The numpy reference of the two compiled passes (the tests hold them equal).
+    def _relations(self, depth):
+        """Return where ``depth`` is nearer, behind, within the band, within half of it."""
         with np.errstate(invalid='ignore'):
             # NaN (no reading, or a pixel never seen) compares False everywhere.
-            offset = depth - background
-            margin = k * self.noise()
-            nearer = offset < -margin
-            behind = offset > margin
-            match = np.abs(offset) <= margin
+            offset = depth - self.background_
+            margin = np.float32(self.noise_k) * self.noise()
             # Learnt from the readings within half the band only: a person just
             # in front of the wall, whose noise reaches into the band now and
             # then, would otherwise pull the mean, and the band, towards them.
-            close = np.abs(offset) <= np.float32(0.5) * margin
-        valid = np.isfinite(depth)
+            return (offset < -margin, offset > margin, np.abs(offset) <= margin,
+                    np.abs(offset) <= np.float32(0.5) * margin)
+
+    def _judge_numpy(self, depth):
+        nearer, behind, match, _ = self._relations(depth)
         trusted = self.hits_ >= np.float32(self.learn_frames)
         verdict = np.zeros(depth.shape, np.uint8)
         verdict[trusted & nearer] = FOREGROUND
         verdict[trusted & (match | behind)] = BACKGROUND
-        judged = np.count_nonzero(verdict)
-        if self.change_fraction < 1 and judged >= _FEWEST_JUDGED * depth.size \
-                and np.count_nonzero(trusted & behind) > self.change_fraction * judged:
-            self.scene_changes_ += 1
-            self._start(depth.shape)
-            none = np.zeros(depth.shape, bool)
-            self._learn(depth, none, valid, none, none)
-            return np.zeros(depth.shape, np.uint8)
-        first = valid & np.isnan(background)
-        self._learn(depth, close, first, nearer, behind)
-        return verdict
+        return verdict, np.count_nonzero(verdict), np.count_nonzero(trusted & behind)
 
-    def _learn(self, depth, match, first, nearer, behind):
-        """Update the model from one image: ``match`` the readings it learns from."""
+    def _learn_numpy(self, depth):
+        nearer, behind, _, close = self._relations(depth)
         background, hits = self.background_, self.hits_
-        self.frames_ += 1
+        first = np.isfinite(depth) & np.isnan(background)
         # At the scene's depth: a running mean over up to span_frames readings.
         count = np.minimum(hits + 1, np.float32(self.span_frames))
-        step = np.where(match, (depth - background) / count, np.float32(0))
-        np.add(background, step, out=background, where=match)
-        np.copyto(hits, count, where=match)
+        step = np.where(close, (depth - background) / count, np.float32(0))
+        np.add(background, step, out=background, where=close)
+        np.copyto(hits, count, where=close)
         # Never seen before: the first reading starts the pixel.
         np.copyto(background, depth, where=first)
         np.copyto(hits, np.float32(1), where=first)
         # In front: held out until absorb_frames readings (a parked object).
         near = self.near_frames_
         near += nearer
-        near[match | behind] = 0
-        absorbed = near >= self.absorb_frames
+        near[close | behind] = 0
+        absorbed = nearer & (near >= self.absorb_frames)
         if absorbed.any():
             np.copyto(background, depth, where=absorbed)
             np.copyto(hits, np.float32(self.learn_frames), where=absorbed)
             near[absorbed] = 0
         # Behind, consistently: the scene uncovered.
-        self._reveal(depth, behind, match | nearer)
+        self._reveal(depth, behind, close | nearer)
 
     def _reveal(self, depth, behind, not_behind):
         far, frames = self._far_depth, self._far_frames
