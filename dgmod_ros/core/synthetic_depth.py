@@ -30,6 +30,9 @@ class WalkAndStop:
         person stands still from then on. The first ``empty_frames`` show the
         wall alone.
     empty_frames : int
+    crossings : int
+        Times the person first walks across the whole view (left to right,
+        ``2 * walk_frames`` each) before walking in and stopping.
     body_depth, wall_depth : float
         Metres along the optical axis; the wall faces the camera.
     person_value : float or None
@@ -49,6 +52,7 @@ class WalkAndStop:
     shape: tuple = (240, 320)
     walk_frames: int = 60
     empty_frames: int = 20
+    crossings: int = 0
     body_depth: float = 1.5
     wall_depth: float = 3.0
     person_value: object = 0.1
@@ -78,8 +82,18 @@ class WalkAndStop:
             return None
         cols = self.shape[1]
         start, stop = -0.25 * self.height_px, (cols - 1) / 2.0
-        progress = min(1.0, (t - self.empty_frames) / max(self.walk_frames, 1))
+        walk = max(self.walk_frames, 1)
+        t = t - self.empty_frames
+        if t < 2 * walk * self.crossings:          # across, out on the right, in again
+            progress = (t % (2 * walk)) / (2 * walk)
+            return start + progress * (cols - 2 * start)
+        progress = min(1.0, (t - 2 * walk * self.crossings) / walk)
         return start + progress * (stop - start)
+
+    @property
+    def still_from(self):
+        """Return the first frame of the person standing still."""
+        return self.empty_frames + self.walk_frames * (2 * self.crossings + 1)
 
     def frame(self, t):
         """
