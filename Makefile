@@ -4,7 +4,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.requirements-installed
 
-.PHONY: demo test bench bench-node bench-stream bench-soak bench-depth clean
+.PHONY: demo test bench bench-node bench-stream bench-soak bench-depth bench-depth-node clean
 
 $(STAMP): requirements.txt setup.py
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -43,6 +43,9 @@ bench-soak: $(STAMP)
 
 bench-depth: $(STAMP)
 	PYTHONPATH=. $(PY) benchmarks/bench_depth.py
+
+bench-depth-node: $(STAMP)
+	PYTHONPATH=. $(PY) benchmarks/bench_depth_node.py $(BENCH_ARGS)
 
 clean:
 	rm -rf $(VENV) out dgmod_ros.egg-info

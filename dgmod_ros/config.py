@@ -69,6 +69,7 @@ _DGMOD = {'method': 'dgmod'}
 _WINDOW = {'method': Not(*_OPENCV_METHODS)}
 _PER_PIXEL = {'decision': ('adaptive', 'uniform')}
 _GLOBAL = {'decision': 'global'}
+_DEPTH = ({'use_depth': True}, {'depth_only': True})
 
 
 @dataclass(frozen=True)
@@ -305,10 +306,45 @@ PARAMETERS = (
               read_only=True, acts=NODE_ONLY),
     Parameter('depth_slop', 0.02, 'largest stamp difference (seconds) of a colour frame and '
               'the depth image paired with it', 0.0, 1.0, acts=NODE_ONLY,
-              active_when={'use_depth': True}),
+              active_when=_DEPTH),
     Parameter('cloud_pixel_step', 2, 'foreground_points takes every n-th pixel in both '
               'directions (1 = every foreground pixel)', 1, 16, acts=NODE_ONLY,
-              active_when={'use_depth': True}),
+              active_when=_DEPTH),
+    # Depth background and fusion (issue 23): depth decides where it can tell.
+    Parameter('depth_background', True, "learn the static scene's depth per pixel and decide "
+              'with it: nearer by more than depth_noise_k noise levels is foreground, at its '
+              'depth background, whatever the colour says; no reading: the colour mask. '
+              'false: the colour mask back-projected as it is', acts=NODE_ONLY,
+              active_when=_DEPTH),
+    Parameter('depth_fuse_mask', True, 'foreground_mask carries the fused mask too (published '
+              "when the frame's depth partner arrives; at once while no depth comes)",
+              acts=NODE_ONLY,
+              active_when=_DEPTH),
+    Parameter('depth_only', False, 'no colour subscription: masks, points and masked depth '
+              'from the depth background alone (a dark scene, a depth-only sensor)',
+              read_only=True, acts=NODE_ONLY),
+    Parameter('depth_noise_base', 0.002, 'depth noise (m, standard deviation) at zero '
+              'distance: sigma(z) = depth_noise_base + depth_noise_quadratic * z^2',
+              0.0001, 1.0, acts=NODE_ONLY,
+              active_when=_DEPTH),
+    Parameter('depth_noise_quadratic', 0.005, 'growth of the depth noise with distance squared '
+              '(1/m); 0.004 for a RealSense D435 at 640 x 480 (subpixel 0.08, 50 mm baseline), '
+              'about half for a 95 mm baseline', 0.0, 1.0, acts=NODE_ONLY,
+              active_when=_DEPTH),
+    Parameter('depth_noise_k', 4.0, 'multiple of the depth noise that makes a pixel nearer '
+              "than the static scene (foreground); within it, at the scene's depth",
+              0.5, 100.0, acts=NODE_ONLY,
+              active_when=_DEPTH),
+    Parameter('depth_learn_frames', 10, "readings at the scene's depth before a pixel's depth "
+              'decides (until then the colour mask does)', 1, 100000, acts=NODE_ONLY,
+              advanced=True, active_when=_DEPTH),
+    Parameter('depth_reveal_frames', 5, 'consistent readings behind the learnt depth that move '
+              'it back (the scene uncovered by what stood there)', 1, 100000, acts=NODE_ONLY,
+              advanced=True, active_when=_DEPTH),
+    Parameter('depth_change_fraction', 0.25, 'share of the judged pixels behind the learnt '
+              'depth in one frame that restarts the depth background and the window (the '
+              'camera moved); 1.0 disables', 0.01, 1.0, acts=NODE_ONLY,
+              advanced=True, active_when=_DEPTH),
 )
 
 BY_NAME = {p.name: p for p in PARAMETERS}

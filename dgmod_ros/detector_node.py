@@ -150,7 +150,9 @@ class DetectorNode(LifecycleNode):
                                                        self._values['solve_threads']))
         sensor_qos = {'callback_group': self._image_group, 'qos_overriding_options':
                       QoSOverridingOptions.with_default_policies()}
-        if self._values['input_transport'] == 'compressed':
+        if self._values['depth_only']:
+            self._subscription = None           # depth images are the input
+        elif self._values['input_transport'] == 'compressed':
             self._subscription = self.create_subscription(
                 CompressedImage, 'image/compressed', self._on_compressed_image,
                 qos_profile_sensor_data, **sensor_qos)
@@ -160,15 +162,17 @@ class DetectorNode(LifecycleNode):
         outputs = QoSProfile(depth=5)
         self._mask_pub = self.create_lifecycle_publisher(Image, 'foreground_mask', outputs)
         self._background_pub = self.create_lifecycle_publisher(Image, 'background', outputs)
-        if self._values['use_depth']:
-            self._depth = DepthOutputs(self, self._values, self._image_group)
+        if self._values['use_depth'] or self._values['depth_only']:
+            self._depth = DepthOutputs(self, self._values, self._image_group,
+                                       self._publish_mask, self._on_depth_scene_change)
         self._apply_node_parameters()
         self._lifecycle_state = 'inactive'
         self.get_logger().info(
             f"detector configured: method {self._values['method']}, window "
             f"{self._values['window']}, stride {self._values['stride']}, scale "
             f"{self._values['scale']}, solve_mode {self._values['solve_mode']}, input "
-            f"{self._subscription.topic_name} ({self._values['input_transport']}), depth "
+            f"{self._subscription.topic_name if self._subscription else 'depth only'} "
+            f"({self._values['input_transport']}), depth "
             f"{'on' if self._depth else 'off'}")
         return TransitionCallbackReturn.SUCCESS
 
@@ -276,11 +280,12 @@ class DetectorNode(LifecycleNode):
                                           throttle_duration_sec=_WARN_PERIOD)
                 return
             background = detector.background_image() if result.new_background else None
-        self._mask_pub.publish(fill_image(Image(), result.mask, 'mono8', msg.header))
-        self._stats.masked(time.monotonic() - received)
-        if self._depth is not None:
-            self._depth.add_mask(msg.header, result.mask)
-        self._watch_foreground_share(result.mask)
+        depth = self._depth
+        held = depth is not None and depth.holds_mask(msg.header)
+        if not held:        # else published fused when its depth image comes
+            self._publish_mask(msg.header, result.mask, received)
+        if depth is not None:
+            depth.add_mask(msg.header, result.mask, received, len(msg.data), held)
         if result.reset:
             self._stats.window_reset()
             self.get_logger().info(f'frame size or encoding changed to {image.shape[1]} x '
@@ -293,6 +298,19 @@ class DetectorNode(LifecycleNode):
             self._publish_background(background, msg.header)
         if self._overlay_pub is not None:
             self._publish_overlay(image, order, value_range, result.mask, msg.header)
+
+    def _publish_mask(self, header, mask, received):
+        self._mask_pub.publish(fill_image(Image(), mask, 'mono8', header))
+        self._stats.masked(time.monotonic() - received)
+        self._watch_foreground_share(mask)
+
+    def _on_depth_scene_change(self):
+        """Restart the window: the depth background restarted (the camera moved)."""
+        with self._lock:
+            if self._detector is not None:
+                self._detector.reset()
+            self._foreground_share = None
+        self._stats.window_reset()
 
     def _watch_foreground_share(self, mask):
         """Count jumps of the foreground share between consecutive frames."""
@@ -313,6 +331,8 @@ class DetectorNode(LifecycleNode):
                 return response
             self._detector.reset()
             self._foreground_share = None
+            if self._depth is not None:
+                self._depth.reset_background()
         self._stats.window_reset()
         self.get_logger().info('window restarted on request')
         response.success = True
@@ -436,6 +456,8 @@ class DetectorNode(LifecycleNode):
                 figures.update(self._detector.status())
             else:
                 figures.update(window_frames=0, model_ready=False)
+        if self._values['depth_only']:
+            figures['model_ready'] = figures.get('depth_model_ready', False)
         if self._worker is not None:
             figures['worker_callback_errors'] = self._worker.callback_errors
         return figures

@@ -31,6 +31,11 @@ class StampPairer:
         Items kept per stream while waiting for a partner; the oldest goes
         first (counted as unpaired) when a stream stalls.
 
+    on_drop : callable or None
+        Called as ``on_drop(primary, payload)`` for every item dropped without
+        partner (``primary`` True for the primary stream): the node publishes
+        a held colour mask then.
+
     Attributes
     ----------
     pairs_ : int
@@ -40,9 +45,10 @@ class StampPairer:
 
     """
 
-    def __init__(self, slop_ns, queue_size=10):
+    def __init__(self, slop_ns, queue_size=10, on_drop=None):
         self.slop_ns = slop_ns
         self.queue_size = queue_size
+        self.on_drop = on_drop
         self.reset()
 
     def validate(self):
@@ -89,22 +95,23 @@ class StampPairer:
                 self._drop(queue)
             other = self.secondary_ if queue is self.primary_ else self.primary_
             while other and other[-1][0] > stamp_ns + self.slop_ns:
-                other.pop()
-                self._count_drop(other)
+                self._discard(other, other.pop())
         queue.append((stamp_ns, payload))
         while len(queue) > self.queue_size:
             self._drop(queue)
         return self._match()
 
     def _drop(self, queue):
-        queue.popleft()
-        self._count_drop(queue)
+        self._discard(queue, queue.popleft())
 
-    def _count_drop(self, queue):
-        if queue is self.primary_:
+    def _discard(self, queue, item):
+        primary = queue is self.primary_
+        if primary:
             self.unpaired_primary_ += 1
         else:
             self.unpaired_secondary_ += 1
+        if self.on_drop is not None:
+            self.on_drop(primary, item[1])
 
     def _match(self):
         pairs = []

@@ -50,8 +50,13 @@ class LargeImageCheck:
         self.warned_ = False
         self._lock = threading.Lock()
 
-    def check(self, size_bytes):
-        """Return the warning text the first time a large image arrives unprofiled, else None."""
+    def check(self, size_bytes, what=None):
+        """
+        Return the warning text the first time a large image arrives unprofiled, else None.
+
+        ``what`` names the payload in the warning (default: images of
+        ``size_bytes`` bytes), for a colour frame and its depth partner.
+        """
         if self.warned_ or size_bytes <= DEFAULT_SEGMENT_BYTES \
                 or self.environ.get(PROFILE_VARIABLE):
             return None
@@ -59,7 +64,8 @@ class LargeImageCheck:
             if self.warned_:
                 return None
             self.warned_ = True
-        return (f'images of {size_bytes} bytes exceed the default Fast DDS '
+        what = what or f'images of {size_bytes} bytes'
+        return (f'{what} exceed the default Fast DDS '
                 f'{DEFAULT_SEGMENT_BYTES} byte shared-memory segment and '
                 f'{PROFILE_VARIABLE} is not set: frames from another process will be '
                 f'lost. Set {PROFILE_VARIABLE}={profile_path()} for the camera driver '

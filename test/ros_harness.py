@@ -141,6 +141,22 @@ class DetectorHarness:
         assert self.spin_until(handled, timeout), 'the detector did not take the depth image'
         return None
 
+    def send_rgbd(self, image_msg, depth_msg, timeout=10.0):
+        """
+        Publish a colour frame, then (once the node took it) its depth image.
+
+        Waits for the depth image's cloud and the frame's mask (the fused
+        mask is published when the depth partner comes); returns the cloud.
+        """
+        before_masks = len(self.masks)
+        frames_in = self.node.statistics()['frames_in']
+        self.publisher.publish(image_msg)
+        assert self.spin_until(lambda: self.node.statistics()['frames_in'] > frames_in,
+                               timeout), 'the detector did not take the frame'
+        cloud = self.send_depth(depth_msg, timeout=timeout)
+        assert self.spin_until(lambda: len(self.masks) > before_masks, timeout), 'no mask'
+        return cloud
+
     def send_camera_info(self, msg, timeout=10.0):
         """Publish a camera info and wait until the node holds it (or dropped it)."""
         before = self.node.statistics()['camera_info_dropped']
