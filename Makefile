@@ -15,11 +15,11 @@ $(STAMP): requirements.txt setup.py
 	$(PY) -m pip install --quiet -e .
 	touch $(STAMP)
 
-# numba compiles the solver's kernels on first use (tens of seconds on two
-# cores, holding the GIL); compiling them here, into the on-disk cache, keeps
-# that out of the node's first solve and out of the tests' time-outs. A warm
-# cache makes this a one-second load.
-KERNELS := $(PY) -c 'from dgmod_ros.core.kernels import compile_all; compile_all()'
+# numba compiles the kernels once per install (30-60 s on two cores, holding
+# the GIL); compiling them here, into the on-disk cache, keeps that out of
+# the demo's first start and out of the tests' time-outs (docs/node.md,
+# "First start"). A warm cache makes this a two-second load.
+KERNELS := $(PY) -m dgmod_ros.core.kernel_cache
 
 demo: $(STAMP)
 	$(KERNELS)

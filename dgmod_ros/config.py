@@ -10,6 +10,7 @@ objects. No ROS import here.
 """
 
 from dataclasses import dataclass
+import sys
 
 import yaml
 
@@ -527,6 +528,10 @@ def detector_class(values):
     return OpenCVSubtractor if values['method'] in _OPENCV_METHODS else SlidingWindowDetector
 
 
+def _say_on_stderr(message):
+    print(message, file=sys.stderr, flush=True)
+
+
 def load_kernels(values, log=None, pending=None, should_stop=None):
     """
     Load the compiled kernels that ``values['method']`` runs (numba's disk cache).
@@ -537,11 +542,12 @@ def load_kernels(values, log=None, pending=None, should_stop=None):
     would count them. OpenCV's subtractors need none. A cache not ready for
     this install is filled by a child process first (``pending``, if one was
     started already), which ``log`` announces and a signal or
-    ``should_stop()`` interrupts (:func:`~dgmod_ros.core.kernel_cache.ensure_ready`).
+    ``should_stop()`` interrupts (:func:`~dgmod_ros.core.kernel_cache.ensure_ready`);
+    without ``log`` (the command line) on stderr.
     """
     if detector_class(values) is SlidingWindowDetector:
         from .core.kernel_cache import ensure_ready
-        ensure_ready(log, pending, should_stop)
+        ensure_ready(log or _say_on_stderr, pending, should_stop)
         from .core.kernels import compile_all       # numba: imported when needed
         compile_all()
 

@@ -27,7 +27,7 @@ that is meant to answer a user or a camera (docs/node.md, "First start").
   sources' paths, mtimes and sizes, the numba and Python versions and the
   CPU. :func:`is_ready` compares it with the running install's key, so a
   process knows before it loads anything whether a load will be a compile.
-- **A compile in a child process** (:func:`compile_in_child`): when the
+- **A compile in a child process** (:class:`ChildCompile`): when the
   cache is not ready, a child fills it while the caller waits in short
   sleeps, so Ctrl-C and SIGTERM stop the caller at once (the child is
   ended with it); the caller then loads the cache in about 2 s.
@@ -227,7 +227,7 @@ class ChildCompile:
         # cache by their paths): the package's parent folder first, and no
         # current folder (-P).
         code = ('import sys; sys.path.insert(0, {!r}); '
-                'from dgmod_ros.core.kernel_cache import main; main()').format(
+                'from dgmod_ros.core.kernel_cache import child_main; child_main()').format(
                     str(PACKAGE_DIR.parent))
         env = dict(os.environ, NUMBA_CACHE_DIR=cache_dir())
         self.started = time.monotonic()
@@ -329,11 +329,27 @@ def ensure_ready(log=None, pending=None, should_stop=None):
 
 
 def main():
-    """Compile (or load) every kernel into the cache, then mark it ready (the child's body)."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    """
+    Compile (or load) every kernel into the cache, then mark it ready.
+
+    ``python3 -m dgmod_ros.core.kernel_cache`` does it ahead of a first
+    start; ``setup.py``'s ``install_kernels`` runs it on the installed files.
+    Returns the exit status (130 after Ctrl-C, which a cold compile may take
+    seconds to notice).
+    """
     from .kernels import compile_all
-    compile_all()
+    try:
+        compile_all()
+    except KeyboardInterrupt:
+        return 130
+    return 0
+
+
+def child_main():
+    """Run :func:`main` as :class:`ChildCompile`'s child: SIGINT is its caller's to handle."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    sys.exit(main())
 
 
 if __name__ == '__main__':
-    main()
+    sys.exit(main())

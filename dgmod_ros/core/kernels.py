@@ -393,7 +393,7 @@ def compile_all():
     A cold compile takes tens of seconds on a small machine and holds the
     GIL: ``colcon build`` runs this at install time, and a process that finds
     the cache cold runs it in a child
-    (:func:`~dgmod_ros.core.kernel_cache.compile_in_child`), then here to
+    (:class:`~dgmod_ros.core.kernel_cache.ChildCompile`), then here to
     load. At the end the cache is marked ready for this install, with the
     compile's seconds where anything was compiled.
     """
