@@ -90,7 +90,7 @@ class Scenario:
         return self.background.image.shape[:2]
 
     def coverage(self, k):
-        """Combined alpha of the actors in frame ``k`` (float32, frame size)."""
+        """Return the actors' combined alpha in frame ``k`` (float32, frame size)."""
         return self._compose(k, with_image=False)[1]
 
     def render(self, k):
@@ -106,7 +106,7 @@ class Scenario:
         return rgb, truth_from_alpha(cover)
 
     def frames(self, count=None):
-        """Yield the frames as :class:`dgmod_ros.inputs.Frame` (RGB), as the detector takes them."""
+        """Yield the frames as :class:`dgmod_ros.inputs.Frame` objects (RGB)."""
         for k in range(self.frames_count if count is None else min(count, self.frames_count)):
             rgb, _ = self.render(k)
             yield Frame(k, f'in{k + 1:06d}', rgb, 'rgb')
@@ -151,7 +151,7 @@ def flicker(count, fps, rng):
 
 
 def wander(count, fps, rng, low_hz=0.05, high_hz=0.35):
-    """A smooth bounded path in [-1, 1]: three sinusoids of random slow frequencies."""
+    """Return a smooth bounded path in [-1, 1]: three sinusoids of random slow frequencies."""
     t = np.arange(count) / fps
     path = sum(np.sin(2 * np.pi * rng.uniform(low_hz, high_hz) * t + rng.uniform(0, 2 * np.pi))
                for _ in range(3))
@@ -204,7 +204,7 @@ class Script:
         self.x, self.y = self.x + amplitude_x * dx[-1], self.y + amplitude_y * dy[-1]
 
     def still(self, frames, pose=None):
-        """Stand perfectly still (same position, same pose, by default the last) for ``frames``."""
+        """Hold position and pose (by default the last) exactly for ``frames`` frames."""
         pose = self._pose() if pose is None else int(pose)
         for _ in range(frames):
             self._emit(self.x, self.y, pose)

@@ -1,6 +1,6 @@
 # Copyright 2026 dgmod_ros authors
 # Licensed under the Apache License, Version 2.0
-"""Write a scenario in the shared data's CDnet layout (what the anchors tool and the benchmarks read)."""
+"""Write a scenario in the shared data's CDnet layout (read by the anchors tool and benchmarks)."""
 
 import json
 from pathlib import Path

@@ -138,6 +138,7 @@ def clean_background(clip_dir, max_frames=150, margin=2, min_seen=3):
     min_seen : int
         Frames a pixel must be background in; fewer and it is marked unseen
         and filled from its neighbours (``cv2.inpaint``).
+
     """
     clip_dir = Path(clip_dir)
     inputs, truths = _numbered(clip_dir / 'input'), _numbered(clip_dir / 'groundtruth')

@@ -48,7 +48,7 @@ def _person_backgrounds(material):
 
 
 def _pick_track(tracks, target_height, rng, exclude=()):
-    """A track tall enough not to be enlarged much (else among the tallest)."""
+    """Pick a track tall enough not to be enlarged much (else one of the tallest)."""
     tracks = [t for t in tracks if id(t) not in exclude] or tracks
     tall = [t for t in tracks if t.height >= 0.6 * target_height]
     if not tall:
@@ -69,7 +69,7 @@ def _width(track, height):
 
 
 def in_view(material, rng, scale):
-    """Two people in view from the first frame, each moving about a small area."""
+    """Script two people in view from the first frame, each moving about a small area."""
     background = material.backgrounds[rng.choice(_person_backgrounds(material))]
     rows, cols = background.image.shape[:2]
     count = _frames(20, scale)
@@ -88,7 +88,7 @@ def in_view(material, rng, scale):
 
 
 def stops(material, rng, scale):
-    """A person walks in, stands still for 60 s, walks out."""
+    """Script a person who walks in, stands still for 60 s, walks out."""
     background = material.backgrounds[rng.choice(_person_backgrounds(material))]
     cols = background.image.shape[1]
     y = _feet_row(background, rng)
@@ -130,7 +130,7 @@ def _close_up_height(background, track, x, coverage):
 
 
 def close_up(material, rng, scale):
-    """A person close to the camera covering 30-60% of the view, moving about."""
+    """Script a person close to the camera covering 30-60% of the view, moving about."""
     clips = sorted(material.backgrounds)
     background = material.backgrounds[rng.choice(clips)]
     rows, cols = background.image.shape[:2]
@@ -155,14 +155,14 @@ def close_up(material, rng, scale):
 
 
 def crossing(material, rng, scale):
-    """Two people enter from opposite sides, linger, cross each other, linger, leave."""
+    """Script two people who enter from opposite sides, linger, cross, linger, leave."""
     background = material.backgrounds[rng.choice(_person_backgrounds(material))]
     rows, cols = background.image.shape[:2]
     _, _, low, high = background.perspective
     rows_of = sorted(rng.uniform(low, high, 2))
     if rows_of[1] - rows_of[0] < 0.3 * (high - low):
         rows_of = [low + 0.2 * (high - low), high - 0.1 * (high - low)]
-    scripts, tracks, used = [], [], set()
+    scripts, used = [], set()
     for k, side in enumerate((1, -1)):
         y = rows_of[k]
         height = background.person_height(y)
