@@ -25,17 +25,19 @@ only where it was chosen:
 
 Cheap runs: ``--params``, ``--sequences``, ``--max-frames N`` (each sequence
 fed up to its first scored frame plus ``N`` frames; the cache keys include
-``N``). Scores are tagged with the commit they were measured on; a later
-commit's run recomputes them (``--any-commit`` reuses them).
+``N``). Scores are tagged with a fingerprint of the code that makes the masks
+(:func:`mask_code`) and the commit; a run with other mask code recomputes
+them (``--any-code`` reuses them).
 
 Usage::
 
     PYTHONPATH=. .venv/bin/python benchmarks/leave_one_out.py [--params pixel_k still_frames]
         [--sequences sbi_IBMtest2 ...] [--max-frames 300] [--cache out/loo_cache.json]
-        [--report-only] [--json out/loo.json]
+        [--report-only] [--detail] [--json out/loo.json]
 """
 
 import argparse
+import hashlib
 import json
 import os
 from pathlib import Path
@@ -63,20 +65,37 @@ GRID = {
     'mrf_beta': (1.0, 2.0, 3.0),
     'median_size': (3, 5, 7),
 }
+REPO = Path(__file__).resolve().parents[1]
 TIE = 1e-4      # mean F differences below this choose the default
 
 
-def commit():
-    """Return the working tree's revision (``+dirty`` with uncommitted changes to code)."""
-    root = Path(__file__).resolve().parents[1]
+def mask_code(root=REPO):
+    """
+    Return a fingerprint of the code that makes the masks (sha1 of its files).
+
+    Every module of the package except the scoring (``core/metrics.py``,
+    ``evaluation.py``), the scenarios and the ROS layer: a cached score is
+    reused while these files are unchanged, whatever else was committed.
+    """
+    package = Path(root) / 'dgmod_ros'
+    skip = {'core/metrics.py', 'evaluation.py', 'detector_node.py', 'depth_outputs.py',
+            'cli.py', 'transport.py', 'solve_worker.py', 'stamp_pairing.py', 'stats.py'}
+    digest = hashlib.sha1()
+    for path in sorted(package.rglob('*.py')):
+        name = path.relative_to(package).as_posix()
+        if name in skip or name.startswith('scenarios/'):
+            continue
+        digest.update(name.encode() + b'\0' + path.read_bytes() + b'\0')
+    return digest.hexdigest()[:12]
+
+
+def commit(root=REPO):
+    """Return the checkout's commit, for the record (``unknown`` outside git)."""
     try:
-        head = subprocess.run(['git', 'rev-parse', '--short', 'HEAD'], cwd=root,
+        return subprocess.run(['git', 'rev-parse', '--short', 'HEAD'], cwd=root,
                               capture_output=True, text=True, check=True).stdout.strip()
-        dirty = subprocess.run(['git', 'status', '--porcelain', '--', 'dgmod_ros'], cwd=root,
-                               capture_output=True, text=True, check=True).stdout.strip()
     except (OSError, subprocess.CalledProcessError):
         return 'unknown'
-    return head + ('+dirty' if dirty else '')
 
 
 def cache_key(name, value, sequence, max_frames):
@@ -88,20 +107,21 @@ def cache_key(name, value, sequence, max_frames):
 class ScoreCache:
     """The JSON file of scores, written after every new score."""
 
-    def __init__(self, path, revision, any_commit):
-        self.path, self.revision, self.any_commit = Path(path), revision, any_commit
+    def __init__(self, path, code, revision, any_code):
+        self.path, self.code, self.revision = Path(path), code, revision
+        self.any_code = any_code
         self.entries = json.loads(self.path.read_text()) if self.path.is_file() else {}
 
     def get(self, key):
-        """Return a cached score or None (or one of another commit, unless allowed)."""
+        """Return a cached score or None (or one of other mask code, unless allowed)."""
         entry = self.entries.get(key)
-        if entry is None or (entry['commit'] != self.revision and not self.any_commit):
+        if entry is None or (entry.get('code') != self.code and not self.any_code):
             return None
         return entry
 
     def put(self, key, row):
         """Store one score and write the file (atomically: a stopped run keeps the rest)."""
-        self.entries[key] = dict(row, commit=self.revision)
+        self.entries[key] = dict(row, code=self.code, commit=self.revision)
         self.path.parent.mkdir(parents=True, exist_ok=True)
         scratch = self.path.with_suffix('.tmp')
         scratch.write_text(json.dumps(self.entries, indent=1, sort_keys=True))
@@ -195,6 +215,20 @@ def table(summaries, sequences):
     return '\n'.join(lines)
 
 
+def detail(summaries, scores, sequences):
+    """Return the markdown table of F for every value on every sequence."""
+    head = ['parameter', 'value'] + [short(s) for s in sequences] + ['mean']
+    lines = ['| ' + ' | '.join(head) + ' |', '|' + ' --- |' * len(head)]
+    for summary in summaries:
+        name = summary['parameter']
+        for value in summary['values']:
+            f = [scores[name][value][s]['fmeasure'] for s in sequences]
+            mark = ' (default)' if value == summary['default'] else ''
+            lines.append(f'| `{name}` | {value}{mark} | ' + ' | '.join(f'{v:.4f}' for v in f)
+                         + f' | {np.mean(f):.4f} |')
+    return '\n'.join(lines)
+
+
 def main(argv=None):
     """Parse the command line, fill the cache, print the leave-one-out table."""
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
@@ -202,26 +236,31 @@ def main(argv=None):
     parser.add_argument('--sequences', nargs='+', default=list(SEQUENCES))
     parser.add_argument('--max-frames', type=int, default=None)
     parser.add_argument('--cache', default='out/loo_cache.json')
-    parser.add_argument('--any-commit', action='store_true',
-                        help='reuse cached scores measured on another commit')
+    parser.add_argument('--any-code', action='store_true',
+                        help='reuse cached scores measured with other mask code')
     parser.add_argument('--report-only', action='store_true',
                         help='compute nothing; report what the cache holds')
     parser.add_argument('--gap', type=float, default=0.005,
                         help='leave-one-out mean this far below the all-seven mean is flagged')
+    parser.add_argument('--detail', action='store_true',
+                        help='also print F for every value on every sequence')
     parser.add_argument('--json', default=None)
     args = parser.parse_args(argv)
     if len(args.sequences) < 3:
         parser.error('leave-one-out needs at least three sequences')
-    revision = commit()
-    cache = ScoreCache(args.cache, revision, args.any_commit)
-    print(f'commit {revision}, cache {args.cache}, max frames {args.max_frames or "all"}',
-          flush=True)
+    code, revision = mask_code(), commit()
+    cache = ScoreCache(args.cache, code, revision, args.any_code)
+    print(f'commit {revision}, mask code {code}, cache {args.cache}, '
+          f'max frames {args.max_frames or "all"}', flush=True)
     scores = run_grid(args.params, args.sequences, args.max_frames, cache,
                       compute=not args.report_only)
     summaries = [s for s in (leave_one_out(n, scores.get(n, {}), args.sequences, args.gap)
                              for n in args.params) if s is not None]
     missing = [n for n in args.params if n not in {s['parameter'] for s in summaries}]
     print(table(summaries, args.sequences))
+    if args.detail:
+        print()
+        print(detail(summaries, scores, args.sequences))
     if summaries:
         print(f"mean over parameters: LOO {np.mean([s['loo_mean'] for s in summaries]):.4f}, "
               f"all-seven {np.mean([s['all_seven_mean'] for s in summaries]):.4f}, "
