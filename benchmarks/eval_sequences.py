@@ -106,7 +106,9 @@ def score_dataset(path, values, mode, masks_dir=None, max_frames=None):
     if out is not None and RECALL_TOOL.is_file():
         report = subprocess.run([sys.executable, str(RECALL_TOOL), str(dataset.path), str(out),
                                  '--json'], capture_output=True, text=True, check=True)
-        row.update(json.loads(report.stdout))
+        recall = json.loads(report.stdout)
+        recall['recall_frames'] = recall.pop('frames')
+        row.update(recall)
     return row
 
 
