@@ -1,9 +1,10 @@
 # Copyright 2026 dgmod_ros authors
 # Licensed under the Apache License, Version 2.0
-"""Scores for backgrounds (RE, PSNR) and foreground masks (CDnet rules)."""
+"""Scores for backgrounds (RE, PSNR), foreground masks (CDnet rules) and people found."""
 
 from dataclasses import dataclass
 
+import cv2
 import numpy as np
 
 #: CDnet ground-truth labels.
@@ -98,3 +99,57 @@ def iou(predicted, truth):
     truth = np.asarray(truth) > 0
     union = np.count_nonzero(predicted | truth)
     return 1.0 if union == 0 else np.count_nonzero(predicted & truth) / union
+
+
+@dataclass
+class PersonCounts:
+    """
+    The planner's view summed over frames: people found and phantom blobs.
+
+    The rule of ``../shared/tools/object_recall.py``: a person is a connected
+    component (8-neighbour) of ground truth 255 of at least ``min_area``
+    pixels, found when the mask covers at least half of it; a false blob is a
+    mask component of at least ``min_area`` pixels that touches no ground-truth
+    foreground or unknown pixel dilated by 5 x 5.
+    """
+
+    min_area: int = 100
+    people: int = 0
+    found: int = 0
+    false_blobs: int = 0
+    frames: int = 0
+
+    def add(self, predicted, groundtruth):
+        """Accumulate one frame: ``predicted`` bool/0-255 mask, ``groundtruth`` CDnet labels."""
+        predicted = np.asarray(predicted) > 0
+        groundtruth = np.asarray(groundtruth)
+        if predicted.shape != groundtruth.shape:
+            raise ValueError(f'mask {predicted.shape} and ground truth {groundtruth.shape} differ')
+        self.frames += 1
+        count, labels, stats, _ = cv2.connectedComponentsWithStats(
+            (groundtruth == GT_FOREGROUND).astype(np.uint8), connectivity=8)
+        big = np.flatnonzero(stats[1:, cv2.CC_STAT_AREA] >= self.min_area) + 1
+        if big.size:
+            covered = np.bincount(labels[predicted], minlength=count)
+            self.people += int(big.size)
+            self.found += int(np.count_nonzero(
+                covered[big] >= 0.5 * stats[big, cv2.CC_STAT_AREA]))
+        count, labels, stats, _ = cv2.connectedComponentsWithStats(
+            predicted.astype(np.uint8), connectivity=8)
+        near = cv2.dilate(((groundtruth == GT_FOREGROUND) | (groundtruth == GT_UNKNOWN))
+                          .astype(np.uint8), np.ones((5, 5), np.uint8)) > 0
+        touching = np.bincount(labels[near], minlength=count) > 0
+        big = stats[:, cv2.CC_STAT_AREA] >= self.min_area
+        big[0] = False
+        self.false_blobs += int(np.count_nonzero(big & ~touching))
+        return self
+
+    @property
+    def person_recall(self):
+        """Share of the ground truth's people found; 0 when there were none."""
+        return self.found / self.people if self.people else 0.0
+
+    @property
+    def false_blobs_per_frame(self):
+        """Phantom blobs per scored frame."""
+        return self.false_blobs / self.frames if self.frames else 0.0
