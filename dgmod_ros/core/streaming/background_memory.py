@@ -85,6 +85,25 @@ class BackgroundMemory(FrameWindow):
         full = np.ones(n, dtype=bool)
         return np.stack([full if o is None else o for o in self._observed], axis=1)
 
+    def overwrite(self, pixels, values):
+        """
+        Put ``values`` (C, n) at ``pixels`` (k,) int into every column: the window heals there.
+
+        The columns are replaced, not written (:meth:`columns` hands them out
+        as never written), and the pixels count as observed in each.
+        """
+        for store in (self._frames, self._observed):
+            old = list(store)
+            store.clear()
+            for entry in old:
+                if entry is not None:
+                    entry = entry.copy()
+                    if entry.ndim == 2:
+                        entry[:, pixels] = values[:, pixels]
+                    else:
+                        entry[pixels] = True
+                store.append(entry)
+
     def clear(self):
         """Forget every column (the admission count goes on)."""
         for store in (self._ids, self._frames, self._observed):
