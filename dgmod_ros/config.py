@@ -138,8 +138,9 @@ PARAMETERS = (
     Parameter('ghost_test', True, 'drop still blobs whose outline is an edge of the background '
               'rather than of the frame (ghosts of what has left); they heal the window'),
     Parameter('still_frames', 25, 'drop pixels that have been in a still blob (nothing in it '
-              'changed by pixel_k / 2 noise levels over 5 frames) for this many frames: ghosts '
-              'that uncover texture; they heal the window; 0 = off', 0, 1000000),
+              'changed by pixel_k / 2 noise levels over 5 frames) for this many frames, unless '
+              'the blob was seen to come in (most of its pixels moved while foreground): '
+              'ghosts that uncover texture; they heal the window; 0 = off', 0, 1000000),
     Parameter('mrf_beta', 2.0, 'coupling of 5 x 5 neighbours in the Potts field that decides '
               'the adaptive mask (log-odds per neighbour, mean field); 0 = threshold and '
               'median filter', 0.0, 100.0),

@@ -148,9 +148,11 @@ def test_moved_inside_marks_changes_of_pixels_already_foreground():
     earlier[1, [6, 7, 8]] = 0.5         # 8: changed by 5 levels only
     earlier[1, 8] = 0.05
     earlier[0, 0] = 1.0                 # a change outside the mask
-    moved = moved_inside(mask, age, frame, earlier, 0.01, 6.0, 5)
+    change = np.abs(frame - earlier).max(axis=0)
+    noise = np.full(20, 0.01, np.float32)
+    moved = moved_inside(mask, age, change, noise, 6.0, 5)
     assert np.flatnonzero(moved).tolist() == [7]
-    assert not moved_inside(mask, None, frame, earlier, 0.01, 6.0, 5).any()
+    assert not moved_inside(mask, None, change, noise, 6.0, 5).any()
 
 
 def test_came_in_needs_most_of_a_blobs_pixels():

@@ -28,6 +28,14 @@ the pixels that are away from the background by a lower multiple of their
 noise level and changing or only lately away (something passing), and admits
 those that have been away for long without changing (the rim of a ghost
 that the held-still rule released).
+
+A ghost the blob tests dropped would heal only as fast as admissions replace
+the window's columns (a window of 30 columns 10 frames apart holds the
+departed object for 150 frames as the l1 majority). Where the place behind
+has held still (the sliding-window detector's ``_note_healing``),
+:meth:`BackgroundMemory.overwrite` puts the frame there into every column
+at the next admission, the way ViBe and SuBSENSE re-seed the samples of a
+pixel found to be a ghost, and the next solve starts there from the data.
 """
 
 from collections import deque

@@ -20,8 +20,16 @@ head, shifts a hand. A blob is *still* when at most ``share`` of its pixels
 changed by more than ``k`` noise levels against the frame a few frames
 before. A pixel that has been in a still blob for ``still_frames``
 consecutive frames is dropped from the mask and enters the window as it is,
-which heals the background; a real object left behind and never touched
-(a bag) goes the same way, earlier than ``absorb_frames``.
+which heals the background.
+
+Stillness alone does not tell a ghost from a person who stops dead (a
+person standing still beside the robot, a bag put down): what the scene
+showed does. Something that came in moved over the pixels it now covers
+while they were already foreground (a body walking in changes the pixels it
+passes over); the place a ghost uncovers holds the background, which does
+not move once uncovered. A blob most of whose pixels moved while foreground
+(:func:`moved_inside`, :func:`came_in`) is never still: it stays foreground
+until ``absorb_frames``.
 """
 
 import numpy as np
@@ -29,27 +37,21 @@ import numpy as np
 from .blobs import BlobMotion
 
 
-def moved_inside(foreground, foreground_age, frame, earlier, noise, k, lag):
+def moved_inside(foreground, foreground_age, change, noise, k, lag):
     """
     Return the pixels (n,) bool that changed while they were already foreground.
 
     A pixel is foreground now and was for the ``lag`` frames before
     (``foreground_age``, the count up to the frame before, at least ``lag``),
-    and differs from ``earlier`` (the frame ``lag`` frames before) by more
-    than ``k`` noise levels: something in front of the background moved
-    over it. The place a ghost uncovers holds the background, which does
-    not move once uncovered.
+    and its ``change`` (n,) against the frame ``lag`` frames before (the
+    largest absolute difference over the channels) exceeds ``k`` noise
+    levels: something in front of the background moved over it. The place a
+    ghost uncovers holds the background, which does not move once uncovered.
     """
     flat = foreground.ravel() > 0
     if foreground_age is None or foreground_age.shape != flat.shape:
         return np.zeros(flat.shape, dtype=bool)
-    pixels = np.flatnonzero(flat & (foreground_age >= lag))
-    moved = np.zeros(flat.shape, dtype=bool)
-    if pixels.size:
-        level = np.broadcast_to(np.asarray(noise, dtype=np.float32), flat.shape)[pixels]
-        change = np.abs(frame[:, pixels] - earlier[:, pixels]).max(axis=0)
-        moved[pixels] = change > k * level
-    return moved
+    return flat & (foreground_age >= lag) & (change > k * np.asarray(noise, dtype=np.float32))
 
 
 def came_in(blobs, entered):
@@ -62,7 +64,7 @@ def came_in(blobs, entered):
     pixels never moved after it appeared.
     """
     labels = blobs.labels.ravel()
-    inside = np.bincount(labels, entered.ravel(), minlength=blobs.count)
+    inside = np.bincount(labels[entered.ravel()], minlength=blobs.count)
     total = np.bincount(labels, minlength=blobs.count)
     return 2 * inside > total
 

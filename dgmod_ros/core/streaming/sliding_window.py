@@ -147,7 +147,14 @@ class SlidingWindowDetector(StreamingDetector):
         changed by more than ``pixel_k / 2`` noise levels against the frame
         5 frames before) for this many consecutive frames; they enter the
         window as they are (ghosts that uncover texture, see
-        :mod:`~dgmod_ros.core.streaming.held_foreground`). 0 disables.
+        :mod:`~dgmod_ros.core.streaming.held_foreground`). A blob seen to
+        come in (most of its pixels moved while foreground) is never still:
+        a person who stops stays foreground for ``absorb_frames``. The
+        pixels a blob test drops that have held still for this many frames
+        (at least 5) heal the window: every column takes the frame there,
+        and the next solve starts from it
+        (:meth:`~dgmod_ros.core.streaming.background_memory.BackgroundMemory.overwrite`).
+        0 disables.
     mrf_beta : float, default=2.0
         > 0: the adaptive decision is a Potts field over the ``pixel_k``-sigma
         rule, coupling 5 x 5 neighbours with this weight (log-odds per
@@ -416,12 +423,18 @@ class SlidingWindowDetector(StreamingDetector):
                 # One labelling for both tests: the ghost test drops whole blobs.
                 blobs = BlobMotion(foreground, columns, earlier, level)
                 before = foreground > 0
+                # Each pixel's change against the earlier frame, for the rules
+                # below that ask it of single pixels.
+                change = np.abs(columns - earlier).max(axis=0)
+                moved = moved_inside(foreground, self.foreground_age_, change, level,
+                                     self.pixel_k, _GHOST_LAG)
+                self.entered_ = moved if self.entered_ is None else moved | self.entered_
                 if self.ghost_test:
                     blobs.drop(ghost_labels(blobs, foreground, columns, background,
                                             self.pixel_k), foreground)
                 if self.still_frames:
                     self._drop_still(foreground, columns, level, blobs)
-                self._note_healing(columns, earlier, level, before, foreground)
+                self._note_healing(columns, change, level, before, foreground)
             result.mask = to_input_size(foreground, self.input_shape_)
         result.buffered = self._admit(columns, background, foreground, result.frame_id,
                                       result.magnitude, level)
@@ -436,36 +449,26 @@ class SlidingWindowDetector(StreamingDetector):
 
     def _drop_still(self, foreground, columns, level, blobs):
         """Clear, in place, the pixels of ``foreground`` held still for ``still_frames``."""
-        earlier = self.recent_[0][1]
-        moved = moved_inside(foreground, self.foreground_age_, columns, earlier, level,
-                             self.pixel_k, _GHOST_LAG)
-        entered = moved if self.entered_ is None else moved | self.entered_
-        still = still_blob_pixels(foreground, columns, earlier, level,
-                                  self.pixel_k / 2, _STILL_SHARE, blobs, entered)
-        self.entered_ = entered
+        still = still_blob_pixels(foreground, columns, self.recent_[0][1], level,
+                                  self.pixel_k / 2, _STILL_SHARE, blobs, self.entered_)
         self.still_age_ = consecutive_frames(self.still_age_, still)
         foreground[self.still_age_.reshape(foreground.shape) >= self.still_frames] = 0
 
-    def _note_healing(self, columns, earlier, level, candidate, foreground):
+    def _note_healing(self, columns, change, level, candidate, foreground):
         """
         Remember where the window should take the frame (blob tests' drops) and the frame there.
 
         ``candidate`` (rows, cols) bool is the foreground before the blob
-        tests, ``foreground`` after them. A pixel heals when a blob test
+        tests, ``foreground`` after them, ``change`` (n,) each pixel's change
+        against the frame ``_GHOST_LAG`` frames before. A pixel heals when a blob test
         dropped it, it was not seen to come in and it has held still (within
         ``pixel_k / 2`` noise levels of the frame ``_GHOST_LAG`` frames
         before) for ``still_frames`` frames as a candidate: the place behind
         holds still, while leaves that a blob test dropped keep moving and
         keep their window.
         """
-        holding = candidate.ravel().copy()
-        if self.entered_ is not None:
-            holding &= ~self.entered_
-        pixels = np.flatnonzero(holding)
-        if pixels.size:
-            noise = np.broadcast_to(np.asarray(level, dtype=np.float32), holding.shape)
-            change = np.abs(columns[:, pixels] - earlier[:, pixels]).max(axis=0)
-            holding[pixels[change > self.pixel_k / 2 * noise[pixels]]] = False
+        holding = candidate.ravel() & ~self.entered_
+        holding &= change <= self.pixel_k / 2 * np.asarray(level, dtype=np.float32)
         self.uncovered_age_ = consecutive_frames(self.uncovered_age_, holding)
         uncovered = ((self.uncovered_age_ >= max(int(self.still_frames), _GHOST_LAG))
                      & (foreground.ravel() == 0))
