@@ -243,8 +243,9 @@ PARAMETERS = (
               'rather than of the frame (ghosts of what has left); they heal the window',
               active_when=_PER_PIXEL),
     Parameter('still_frames', 25, 'drop pixels that have been in a still blob (nothing in it '
-              'changed by pixel_k / 2 noise levels over 5 frames) for this many frames: ghosts '
-              'that uncover texture; they heal the window; 0 = off', 0, 1000000,
+              'changed by pixel_k / 2 noise levels over 5 frames) for this many frames, unless '
+              'the blob was seen to come in (most of its pixels moved while foreground): '
+              'ghosts that uncover texture; they heal the window; 0 = off', 0, 1000000,
               active_when=_PER_PIXEL),
     Parameter('mrf_beta', 2.0, 'coupling of 5 x 5 neighbours in the Potts field that decides '
               'the per-pixel mask (log-odds per neighbour, mean field); 0 = threshold and '

@@ -2,13 +2,16 @@
 # Licensed under the Apache License, Version 2.0
 """The streaming decision's pieces: warm-up noise level, still blobs, held ghosts."""
 
+from dgmod_ros.core.dgmod import ADMMState
 from dgmod_ros.core.streaming import SlidingWindowDetector
-from dgmod_ros.core.streaming.background_memory import held_pixels
+from dgmod_ros.core.streaming.background_memory import BackgroundMemory, held_pixels
+from dgmod_ros.core.streaming.blobs import BlobMotion
 from dgmod_ros.core.streaming.coherence import mean_field_mask
 from dgmod_ros.core.streaming.fast_path import projection_residual, robust_projection
 from dgmod_ros.core.streaming.foreground import (adaptive_mask, consecutive_frames,
                                                  moving_texture_k, pixel_noise, warmup_noise)
-from dgmod_ros.core.streaming.held_foreground import still_blob_pixels
+from dgmod_ros.core.streaming.held_foreground import came_in, moved_inside, still_blob_pixels
+from dgmod_ros.core.streaming.window_solve import healed_starts
 import numpy as np
 import pytest
 
@@ -108,6 +111,117 @@ def test_a_ghost_that_uncovers_texture_is_dropped_after_still_frames():
 
 def test_a_stopped_object_that_moves_a_little_is_kept():
     assert _held_share(30, ghost=False) > 0.9
+
+
+def _walks_in_and_stops(frames=150, arrive=40, stop=60):
+    """Yield a textured wall and a textured box that slides in from the left and stops dead."""
+    rng = np.random.default_rng(5)
+    wall = rng.uniform(0.5, 0.9, (48, 64, 3)).astype(np.float32)
+    body = rng.uniform(0.0, 0.3, (20, 24, 3)).astype(np.float32)
+    for index in range(frames):
+        image = wall + rng.normal(0, 0.004, wall.shape).astype(np.float32)
+        if index >= arrive:
+            left = 20 - 2 * max(stop - index, 0)
+            if left + 24 > 0:
+                image[16:36, max(left, 0):left + 24] = body[:, max(-left, 0):]
+        yield np.clip(image, 0, 1)
+
+
+def test_an_object_seen_to_come_in_is_kept_when_it_stops_dead():
+    # Nothing in the box changes for 90 frames once it stops: the still-blob
+    # rule alone would drop it after still_frames; it was seen to come in.
+    detector = SlidingWindowDetector(still_frames=25)
+    masks = [detector.process(image)[0].mask for image in _walks_in_and_stops()]
+    box = np.zeros(masks[0].shape, bool)
+    box[18:34, 22:42] = True
+    assert min(m[box].mean() / 255 for m in masks[-60:]) > 0.9
+
+
+def test_moved_inside_marks_changes_of_pixels_already_foreground():
+    mask = np.zeros((4, 5), np.uint8)
+    mask[1:3, 1:4] = 255
+    age = np.zeros(20, np.int32)
+    age[mask.ravel() > 0] = 5
+    age[6] = 4                          # foreground for fewer frames than the lag
+    frame = np.zeros((3, 20), np.float32)
+    earlier = frame.copy()
+    earlier[1, [6, 7, 8]] = 0.5         # 8: changed by 5 levels only
+    earlier[1, 8] = 0.05
+    earlier[0, 0] = 1.0                 # a change outside the mask
+    change = np.abs(frame - earlier).max(axis=0)
+    noise = np.full(20, 0.01, np.float32)
+    moved = moved_inside(mask, age, change, noise, 6.0, 5)
+    assert np.flatnonzero(moved).tolist() == [7]
+    assert not moved_inside(mask, None, change, noise, 6.0, 5).any()
+
+
+def test_came_in_needs_most_of_a_blobs_pixels():
+    mask = _two_blobs()
+    frame = np.zeros((3, mask.size), np.float32)
+    blobs = BlobMotion(mask, frame, frame, np.full(mask.size, 0.01, np.float32))
+    entered = np.zeros(mask.shape, bool)
+    entered[2:8, 2:6] = True            # 24 of blob A's 36 pixels
+    entered[10:14, 15:25] = True        # 40 of blob B's 80: not most
+    assert came_in(blobs, entered.ravel()).tolist() == [False, True, False]
+    # A blob that came in is not still, however little changes in it.
+    still = still_blob_pixels(mask, frame, frame, 0.01, 3.0, 0.01, blobs, entered.ravel())
+    assert not still[2:8, 2:8].any() and still[10:18, 15:25].all()
+
+
+def test_overwrite_replaces_every_column_at_the_pixels_and_marks_them_observed():
+    memory = BackgroundMemory(3)
+    columns = [np.full((3, 6), float(i), np.float32) for i in range(3)]
+    for index, column in enumerate(columns):
+        observed = np.array([True, False, True, False, True, True]) if index == 1 else None
+        memory.append(column, index, observed)
+    values = np.arange(18, dtype=np.float32).reshape(3, 6)
+    memory.overwrite(np.array([1, 3]), values)
+    for index, column in enumerate(memory.columns()):
+        assert column is not columns[index]                   # buffered columns are never written
+        assert np.array_equal(column[:, [1, 3]], values[:, [1, 3]])
+        assert np.all(column[:, [0, 2, 4, 5]] == index)
+        assert np.all(columns[index] == index)
+    observed = memory.observed()
+    assert observed[:, 0].all() and observed[:, 2].all()        # None: all observed
+    assert observed[:, 1].tolist() == [True] * 6
+
+
+def test_the_window_heals_where_a_ghost_was_dropped():
+    # The box is in the first 40 frames (learnt), then leaves; its place is a
+    # ghost that the blob tests drop and that holds still: every column of
+    # the window takes the wall there, not only the columns admitted since.
+    detector = SlidingWindowDetector()
+    for image in _box_scene(ghost=True, frames=100):
+        detector.process(image)
+    rows, cols, channels = detector.shape_
+    box = np.zeros((rows, cols), bool)
+    box[9:17, 11:21] = True                     # inside the box at the processing size
+    window = np.stack(detector.buffer_.columns())[:, :, box.ravel()]
+    assert window.min() > 0.25                  # the box is 0.1, the wall 0.3-0.9
+    assert len(window) == detector.window
+
+
+def test_healed_starts_start_the_healed_pixels_from_the_data():
+    rng = np.random.default_rng(1)
+    n, m = 12, 5
+    state = ADMMState(*(rng.uniform(size=(n, m)).astype(np.float32) for _ in range(6)),
+                      weights=np.ones(m, np.float32))
+    data = rng.uniform(size=(1, n, m)).astype(np.float32)
+    healed = np.zeros(n, bool)
+    healed[[0, 5]] = True
+    start, = healed_starts([state], data, healed, (3, 4, 1), (3, 4, 1))
+    for name in ('background', 'low_rank'):
+        assert np.array_equal(getattr(start, name)[[0, 5]], data[0][[0, 5]])
+    for name in ('foreground', 'noise', 'dual_low_rank', 'dual_noise'):
+        assert not getattr(start, name)[[0, 5]].any()
+    keep = ~healed
+    assert np.array_equal(start.background[keep], state.background[keep])
+    assert healed_starts([None], data, healed, (3, 4, 1), (3, 4, 1)) == [None]
+    # A downscaled solve: a healed pixel marks every solved pixel it overlaps.
+    small, = healed_starts([state], data[:, :2], np.eye(1, 16, 0, dtype=bool).ravel(),
+                           (4, 4, 1), (1, 2, 1))
+    assert np.array_equal(small.background[0], data[0][0])
+    assert np.array_equal(small.background[1:], state.background[1:])
 
 
 def _field(z_image, beta):

@@ -28,6 +28,14 @@ the pixels that are away from the background by a lower multiple of their
 noise level and changing or only lately away (something passing), and admits
 those that have been away for long without changing (the rim of a ghost
 that the held-still rule released).
+
+A ghost the blob tests dropped would heal only as fast as admissions replace
+the window's columns (a window of 30 columns 10 frames apart holds the
+departed object for 150 frames as the l1 majority). Where the place behind
+has held still (the sliding-window detector's ``_note_healing``),
+:meth:`BackgroundMemory.overwrite` puts the frame there into every column
+at the next admission, the way ViBe and SuBSENSE re-seed the samples of a
+pixel found to be a ghost, and the next solve starts there from the data.
 """
 
 from collections import deque
@@ -84,6 +92,25 @@ class BackgroundMemory(FrameWindow):
         n = self._frames[0].shape[1]
         full = np.ones(n, dtype=bool)
         return np.stack([full if o is None else o for o in self._observed], axis=1)
+
+    def overwrite(self, pixels, values):
+        """
+        Put ``values`` (C, n) at ``pixels`` (k,) int into every column: the window heals there.
+
+        The columns are replaced, not written (:meth:`columns` hands them out
+        as never written), and the pixels count as observed in each.
+        """
+        for store in (self._frames, self._observed):
+            old = list(store)
+            store.clear()
+            for entry in old:
+                if entry is not None:
+                    entry = entry.copy()
+                    if entry.ndim == 2:
+                        entry[:, pixels] = values[:, pixels]
+                    else:
+                        entry[pixels] = True
+                store.append(entry)
 
     def clear(self):
         """Forget every column (the admission count goes on)."""

@@ -20,14 +20,56 @@ head, shifts a hand. A blob is *still* when at most ``share`` of its pixels
 changed by more than ``k`` noise levels against the frame a few frames
 before. A pixel that has been in a still blob for ``still_frames``
 consecutive frames is dropped from the mask and enters the window as it is,
-which heals the background; a real object left behind and never touched
-(a bag) goes the same way, earlier than ``absorb_frames``.
+which heals the background.
+
+Stillness alone does not tell a ghost from a person who stops dead (a
+person standing still beside the robot, a bag put down): what the scene
+showed does. Something that came in moved over the pixels it now covers
+while they were already foreground (a body walking in changes the pixels it
+passes over); the place a ghost uncovers holds the background, which does
+not move once uncovered. A blob most of whose pixels moved while foreground
+(:func:`moved_inside`, :func:`came_in`) is never still: it stays foreground
+until ``absorb_frames``.
 """
+
+import numpy as np
 
 from .blobs import BlobMotion
 
 
-def still_blob_pixels(mask, frame, earlier, noise, k, share, blobs=None):
+def moved_inside(foreground, foreground_age, change, noise, k, lag):
+    """
+    Return the pixels (n,) bool that changed while they were already foreground.
+
+    A pixel is foreground now and was for the ``lag`` frames before
+    (``foreground_age``, the count up to the frame before, at least ``lag``),
+    and its ``change`` (n,) against the frame ``lag`` frames before (the
+    largest absolute difference over the channels) exceeds ``k`` noise
+    levels: something in front of the background moved over it. The place a
+    ghost uncovers holds the background, which does not move once uncovered.
+    """
+    flat = foreground.ravel() > 0
+    if foreground_age is None or foreground_age.shape != flat.shape:
+        return np.zeros(flat.shape, dtype=bool)
+    return flat & (foreground_age >= lag) & (change > k * np.asarray(noise, dtype=np.float32))
+
+
+def came_in(blobs, entered):
+    """
+    Return per blob (count,) bool whether it was seen to come in.
+
+    ``entered`` (n,) bool marks the pixels that have moved while foreground
+    (:func:`moved_inside`, held while they stay foreground). A blob most of
+    whose pixels did is something that came in and stopped; a ghost's
+    pixels never moved after it appeared.
+    """
+    labels = blobs.labels.ravel()
+    inside = np.bincount(labels[entered.ravel()], minlength=blobs.count)
+    total = np.bincount(labels, minlength=blobs.count)
+    return 2 * inside > total
+
+
+def still_blob_pixels(mask, frame, earlier, noise, k, share, blobs=None, entered=None):
     """
     Return the pixels (rows, cols) bool of foreground blobs in which nothing moved.
 
@@ -46,6 +88,9 @@ def still_blob_pixels(mask, frame, earlier, noise, k, share, blobs=None):
     blobs : BlobMotion or None
         The blobs of ``mask`` (or of a mask from which :meth:`BlobMotion.drop`
         removed blobs) against ``earlier``, when already labelled.
+    entered : ndarray (n,) bool or None
+        The pixels that moved while foreground (:func:`came_in`): a blob
+        seen to come in is never still. None: no blob is exempt.
 
     """
     if blobs is None:
@@ -53,4 +98,6 @@ def still_blob_pixels(mask, frame, earlier, noise, k, share, blobs=None):
     still = blobs.moving_share(k) <= share
     still[0] = False
     still &= ~blobs.dropped
+    if entered is not None and still.any():
+        still &= ~came_in(blobs, entered)
     return blobs.pixels(still)

@@ -106,6 +106,7 @@ class WindowSnapshot:
     solve_shape: tuple = None   # (rows, cols, C) the window is solved at; None: ``shape``
     refit_background: bool = False  # refit each pixel's series on the solve's factors
     column_cache: object = None  # ColumnCache of the columns in ``data`` (solve_resolution)
+    healed: np.ndarray = None   # (n,) bool: pixels the window took a frame at since the last solve
 
     def window(self):
         """

@@ -19,7 +19,7 @@ from .contract import StreamingDetector
 from .fast_path import robust_projection
 from .foreground import (adaptive_mask, consecutive_frames, ghost_labels, to_input_size,
                          warmup_noise)
-from .held_foreground import still_blob_pixels
+from .held_foreground import moved_inside, still_blob_pixels
 from .photometric import LightingTest
 from .results import FrameResult, WindowSnapshot
 from .settings import assign_validated, check_window_parameters
@@ -147,7 +147,14 @@ class SlidingWindowDetector(StreamingDetector):
         changed by more than ``pixel_k / 2`` noise levels against the frame
         5 frames before) for this many consecutive frames; they enter the
         window as they are (ghosts that uncover texture, see
-        :mod:`~dgmod_ros.core.streaming.held_foreground`). 0 disables.
+        :mod:`~dgmod_ros.core.streaming.held_foreground`). A blob seen to
+        come in (most of its pixels moved while foreground) is never still:
+        a person who stops stays foreground for ``absorb_frames``. The
+        pixels a blob test drops that have held still for this many frames
+        (at least 5) heal the window: every column takes the frame there,
+        and the next solve starts from it
+        (:meth:`~dgmod_ros.core.streaming.background_memory.BackgroundMemory.overwrite`).
+        0 disables.
     mrf_beta : float, default=2.0
         > 0: the adaptive decision is a Potts field over the ``pixel_k``-sigma
         rule, coupling 5 x 5 neighbours with this weight (log-odds per
@@ -321,6 +328,10 @@ class SlidingWindowDetector(StreamingDetector):
             self.foreground_age_ = None
             self.still_age_ = None
             self.away_age_ = None
+            self.entered_ = None
+            self.heal_ = None
+            self.healed_ = None
+            self.uncovered_age_ = None
         return self
 
     def reset(self):
@@ -331,6 +342,10 @@ class SlidingWindowDetector(StreamingDetector):
         self.foreground_age_ = None
         self.still_age_ = None
         self.away_age_ = None
+        self.entered_ = None
+        self.heal_ = None
+        self.healed_ = None
+        self.uncovered_age_ = None
         self.recent_ = deque(maxlen=_GHOST_LAG)
         self.scene_watch_ = SceneChangeWatch()
         self.background_model_ = None
@@ -407,11 +422,19 @@ class SlidingWindowDetector(StreamingDetector):
                     and earlier is not None):
                 # One labelling for both tests: the ghost test drops whole blobs.
                 blobs = BlobMotion(foreground, columns, earlier, level)
+                before = foreground > 0
+                # Each pixel's change against the earlier frame, for the rules
+                # below that ask it of single pixels.
+                change = np.abs(columns - earlier).max(axis=0)
+                moved = moved_inside(foreground, self.foreground_age_, change, level,
+                                     self.pixel_k, _GHOST_LAG)
+                self.entered_ = moved if self.entered_ is None else moved | self.entered_
                 if self.ghost_test:
                     blobs.drop(ghost_labels(blobs, foreground, columns, background,
                                             self.pixel_k), foreground)
                 if self.still_frames:
                     self._drop_still(foreground, columns, level, blobs)
+                self._note_healing(columns, change, level, before, foreground)
             result.mask = to_input_size(foreground, self.input_shape_)
         result.buffered = self._admit(columns, background, foreground, result.frame_id,
                                       result.magnitude, level)
@@ -427,13 +450,42 @@ class SlidingWindowDetector(StreamingDetector):
     def _drop_still(self, foreground, columns, level, blobs):
         """Clear, in place, the pixels of ``foreground`` held still for ``still_frames``."""
         still = still_blob_pixels(foreground, columns, self.recent_[0][1], level,
-                                  self.pixel_k / 2, _STILL_SHARE, blobs)
+                                  self.pixel_k / 2, _STILL_SHARE, blobs, self.entered_)
         self.still_age_ = consecutive_frames(self.still_age_, still)
         foreground[self.still_age_.reshape(foreground.shape) >= self.still_frames] = 0
+
+    def _note_healing(self, columns, change, level, candidate, foreground):
+        """
+        Remember where the window should take the frame (blob tests' drops) and the frame there.
+
+        ``candidate`` (rows, cols) bool is the foreground before the blob
+        tests, ``foreground`` after them, ``change`` (n,) each pixel's change
+        against the frame ``_GHOST_LAG`` frames before. A pixel heals when a blob test
+        dropped it, it was not seen to come in and it has held still (within
+        ``pixel_k / 2`` noise levels of the frame ``_GHOST_LAG`` frames
+        before) for ``still_frames`` frames as a candidate: the place behind
+        holds still, while leaves that a blob test dropped keep moving and
+        keep their window.
+        """
+        holding = candidate.ravel() & ~self.entered_
+        holding &= change <= self.pixel_k / 2 * np.asarray(level, dtype=np.float32)
+        self.uncovered_age_ = consecutive_frames(self.uncovered_age_, holding)
+        uncovered = ((self.uncovered_age_ >= max(int(self.still_frames), _GHOST_LAG))
+                     & (foreground.ravel() == 0))
+        if not uncovered.any():
+            return
+        if self.heal_ is None:
+            self.heal_ = (uncovered, columns.copy())
+            return
+        pixels, values = self.heal_
+        pixels |= uncovered
+        values[:, uncovered] = columns[:, uncovered]
 
     def _admit(self, columns, background, foreground, frame_id, distance, level):
         """Put the frame into the window if due (conditionally); return whether it went in."""
         self.foreground_age_ = consecutive_frames(self.foreground_age_, foreground > 0)
+        if self.entered_ is not None:
+            self.entered_ = self.entered_ & (self.foreground_age_ > 0)
         if self.hold_changes and self.decision != 'global':
             self.away_ = distance.ravel() > self.pixel_k / 2 * level
             self.away_age_ = consecutive_frames(self.away_age_, self.away_)
@@ -456,6 +508,13 @@ class SlidingWindowDetector(StreamingDetector):
             columns, observed = conditional_columns(columns, background, grown,
                                                     self.foreground_age_, self.absorb_frames,
                                                     replace)
+        if self.heal_ is not None:
+            # The place behind what left, seen since the last admission: every
+            # column holds it from now on, so the next solve learns it.
+            pixels, values = self.heal_
+            self.buffer_.overwrite(np.flatnonzero(pixels), values)
+            self.healed_ = pixels if self.healed_ is None else self.healed_ | pixels
+            self.heal_ = None
         self.buffer_.append(columns, frame_id, observed)
         return True
 
@@ -480,6 +539,10 @@ class SlidingWindowDetector(StreamingDetector):
         self.foreground_age_ = None
         self.still_age_ = None
         self.away_age_ = None
+        self.entered_ = None
+        self.heal_ = None
+        self.healed_ = None
+        self.uncovered_age_ = None
         self.background_model_ = None
         self.background_pending_ = False
         self.scene_changes_ += 1
@@ -550,7 +613,8 @@ class SlidingWindowDetector(StreamingDetector):
                               solve_shape=solve_shape(self.shape_, int(self.solve_pixels),
                                                       float(self.solve_scale)),
                               refit_background=bool(self.refit_background),
-                              column_cache=self.column_cache_)
+                              column_cache=self.column_cache_, healed=self.healed_)
+        self.healed_ = None
 
     def solve(self, snapshot):
         """

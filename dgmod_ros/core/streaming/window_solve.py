@@ -2,8 +2,10 @@
 # Licensed under the Apache License, Version 2.0
 """One window solve: a :class:`~.results.WindowSnapshot` in, a background model out."""
 
+from dataclasses import replace
 import time
 
+import cv2
 import numpy as np
 
 from .fast_path import background_basis, projection_residual, sampled_basis
@@ -41,6 +43,39 @@ def warm_starts(snapshot):
     if not 0 <= shift < width or previous.states[0].frames != width:
         return [None] * channels
     return [state.shifted(shift) for state in previous.states]
+
+
+def healed_starts(starts, data, healed, shape, small_shape):
+    """
+    Return the warm starts with the pixels of ``healed`` started from the data itself.
+
+    Where the window took the frame in every column
+    (:meth:`~.background_memory.BackgroundMemory.overwrite`), the previous
+    solve's iterates hold what has left; a few warm sweeps would carry them
+    on, and the refit holds out the entries the solve calls foreground. There
+    the start is ``L = U = D`` with no foreground, noise or duals. A healed
+    pixel covers every solved pixel its area overlaps.
+    """
+    if healed is None or not healed.any() or all(s is None for s in starts):
+        return starts
+    rows, cols = shape[:2]
+    area = healed.reshape(rows, cols).astype(np.float32)
+    if tuple(small_shape[:2]) != (rows, cols):
+        area = cv2.resize(area, (small_shape[1], small_shape[0]), interpolation=cv2.INTER_AREA)
+    pixels = np.flatnonzero(area > 0)
+    healed_states = []
+    for channel, state in enumerate(starts):
+        if state is None:
+            healed_states.append(None)
+            continue
+        arrays = {}
+        for name in ('background', 'low_rank', 'foreground', 'noise', 'dual_low_rank',
+                     'dual_noise'):
+            array = getattr(state, name).copy()
+            array[pixels] = data[channel][pixels] if name in ('background', 'low_rank') else 0
+            arrays[name] = array
+        healed_states.append(replace(state, **arrays))
+    return healed_states
 
 
 def _sampled(sample, array):
@@ -115,8 +150,9 @@ def solve_window(snapshot):
     else:
         data = cache.small_window(columns, snapshot.shape, small_shape)
     try:
-        separated = separate_channels(snapshot.model, data, small_shape[:2],
-                                      warm_starts(snapshot))
+        starts = healed_starts(warm_starts(snapshot), data, snapshot.healed, snapshot.shape,
+                               small_shape)
+        separated = separate_channels(snapshot.model, data, small_shape[:2], starts)
     except (ValueError, FloatingPointError, np.linalg.LinAlgError) as error:
         raise SolverFailure(f'window solve failed: {error}') from error
     backgrounds, residuals = separated.backgrounds, separated.residuals
