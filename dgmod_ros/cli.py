@@ -123,9 +123,8 @@ def _add_parameter_options(parser, command):
         for spec in specs:
             option = option_name(spec.name)
             tag = _MODE_TAGS[tuple(c for c in (STREAM, BATCH) if c in spec.acts)]
-            kwargs = {'dest': spec.name, 'default': None,
-                      'help': (config.describe(spec, OFFLINE) + tag).replace(
-                          '%', '%%')}
+            text = config.describe(spec, OFFLINE) + tag
+            kwargs = {'dest': spec.name, 'default': None, 'help': text.replace('%', '%%')}
             if isinstance(spec.default, bool):
                 group.add_argument(option, action=_BooleanValue, nargs='?', metavar='BOOL',
                                    **kwargs)
@@ -202,7 +201,7 @@ def resolve_parameters(args):
     return config.validate(values), given
 
 
-def warn_inert(values, given, mode, methods=None, stream=None):
+def warn_inert(values, given, mode, methods=None):
     """
     Print one warning line for each parameter given that has no effect here.
 
@@ -213,8 +212,7 @@ def warn_inert(values, given, mode, methods=None, stream=None):
         found = config.inert_parameters(dict(values, method=method), given, mode)
         inert = found if inert is None else {n: r for n, r in inert.items() if n in found}
     for name, reason in inert.items():
-        print(f'dgmod: warning: {given[name]} has no effect: {reason}',
-              file=stream or sys.stderr)
+        print(f'dgmod: warning: {given[name]} has no effect: {reason}', file=sys.stderr)
 
 
 def _good_frames(frames, skip_bad, skipped):

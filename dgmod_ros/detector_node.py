@@ -101,7 +101,7 @@ class DetectorNode(LifecycleNode):
             self.declare_parameter(spec.name, spec.default, _descriptor(spec))
             self._values[spec.name] = self.get_parameter(spec.name).value
         config.validate(self._values)       # a bad parameter file stops the node here
-        self._warn_inert(self._values, self._values_set(self._values))
+        self._warn_inert(self._values, self._set_by_user(self._values))
         for name in getattr(self, '_parameter_overrides', {}):   # rclpy keeps the overrides
             if name in config.BY_NAME and not self.has_parameter(name):
                 reason = config.inert_reason(name, self._values, config.NODE)
@@ -422,11 +422,12 @@ class DetectorNode(LifecycleNode):
         self.get_logger().info('parameters changed: ' + ', '.join(
             f'{name}={value}' for name, value in sorted(changed.items())))
         # The changed ones that do nothing, and those set before that this change made inert.
-        before = config.inert_parameters(previous, self._values_set(previous), config.NODE)
-        self._warn_inert(values, set(changed) | (self._values_set(values) - set(before)))
+        before = config.inert_parameters(previous, self._set_by_user(previous), config.NODE)
+        self._warn_inert(values, set(changed) | (self._set_by_user(values) - set(before)))
 
     @staticmethod
-    def _values_set(values):
+    def _set_by_user(values):
+        # A full parameter file repeats the defaults: only other values count as set.
         return {spec.name for spec in config.reads(config.NODE)
                 if values[spec.name] != spec.default}
 
