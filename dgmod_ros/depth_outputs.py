@@ -164,7 +164,7 @@ class DepthOutputs:
         self._account(self._pairer.clear)
 
     def reset_background(self):
-        """Forget the learnt depth (``~/reset_background``, the colour window restarted)."""
+        """Forget the learnt depth (``~/reset_background``: the camera was moved)."""
         if self._model is not None:
             self._model.reset()
 
