@@ -1,7 +1,7 @@
 # Copyright 2026 dgmod_ros authors
 # Licensed under the Apache License, Version 2.0
 """
-An RGB-D camera and a planner-side client in another process than the detector: how much of the person is in the cloud.
+An RGB-D camera and a client in another process than the detector: the person in the cloud.
 
 The camera process publishes a synthetic RGB-D scene at 30 frames/s
 (sensor-data QoS, as drivers do): rgb8 colour, registered depth (16UC1 or

@@ -50,8 +50,9 @@ from .transport import DEFAULT_SEGMENT_BYTES, LargeImageCheck
 # Seconds between repeats of one kind of warning.
 _WARN_PERIOD = 5.0
 # A colour mask is held for its depth partner only while depth images come:
-# the newest one stamped at most this many seconds before the frame.
-_DEPTH_STALL_S = 0.5
+# the newest one stamped at most this many seconds before the frame (a depth
+# camera at 6 frames/s and more; a stall costs masks at most this much delay).
+_DEPTH_STALL_S = 0.25
 
 
 def depth_background(values):
@@ -163,7 +164,7 @@ class DepthOutputs:
         self._account(self._pairer.clear)
 
     def reset_background(self):
-        """Forget the learnt depth (``~/reset_background``, the colour window restarted)."""
+        """Forget the learnt depth (``~/reset_background``: the camera was moved)."""
         if self._model is not None:
             self._model.reset()
 
@@ -173,7 +174,7 @@ class DepthOutputs:
         Tell whether this side publishes the colour frame's mask (fused) when its depth comes.
 
         True with ``depth_fuse_mask`` while depth images arrive (the newest
-        stamped at most 0.5 s before the frame); otherwise the node publishes
+        stamped at most 0.25 s before the frame); otherwise the node publishes
         the colour mask at once.
         """
         return (self._fuse_mask and self._newest_depth_ns is not None
@@ -188,6 +189,8 @@ class DepthOutputs:
         ``frame_bytes``: the colour message's size, for the transport check.
         """
         self._colour_bytes = frame_bytes
+        if self._fuse_mask and not held:
+            self._release_held()          # depth stopped: what waits for it goes out now
         self._account(lambda: self._publish(
             self._pairer.add_primary(stamp_ns(header), (header, mask, received, held))))
 
@@ -280,6 +283,13 @@ class DepthOutputs:
         info_out.header = header
         self._info_pub.publish(info_out)
         self._count('clouds_out')
+
+    def _release_held(self):
+        queue = self._pairer.primary_
+        for index, (stamp, (header, mask, received, held)) in enumerate(queue):
+            if held:
+                self._publish_mask(header, mask, received)
+                queue[index] = (stamp, (header, mask, received, False))
 
     def _on_unpaired(self, primary, payload):
         """Publish a held colour mask that will get no depth partner, as it is."""

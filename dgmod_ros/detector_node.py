@@ -294,10 +294,10 @@ class DetectorNode(LifecycleNode):
             background = detector.background_image() if result.new_background else None
         depth = self._depth
         held = depth is not None and depth.holds_mask(msg.header)
-        if not held:        # else published fused when its depth image comes
-            self._publish_mask(msg.header, result.mask, received)
-        if depth is not None:
+        if depth is not None:       # first: it may release masks held before this one
             depth.add_mask(msg.header, result.mask, received, len(msg.data), held)
+        if not held:                # else published fused when its depth image comes
+            self._publish_mask(msg.header, result.mask, received)
         if result.reset:
             self._stats.window_reset()
             self.get_logger().info(f'frame size or encoding changed to {image.shape[1]} x '

@@ -30,7 +30,6 @@ class StampPairer:
     queue_size : int
         Items kept per stream while waiting for a partner; the oldest goes
         first (counted as unpaired) when a stream stalls.
-
     on_drop : callable or None
         Called as ``on_drop(primary, payload)`` for every item dropped without
         partner (``primary`` True for the primary stream): the node publishes

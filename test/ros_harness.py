@@ -157,6 +157,23 @@ class DetectorHarness:
         assert self.spin_until(lambda: len(self.masks) > before_masks, timeout), 'no mask'
         return cloud
 
+    def replay_rgbd(self, messages):
+        """
+        Send a driver's recording: ``(topic, message)`` of colour, camera info and depth.
+
+        Colour topics end in ``color/image_raw``, camera infos in ``camera_info``,
+        the rest is depth; a colour frame is sent with the depth image after it
+        (:meth:`send_rgbd`). Yields ``(depth message, its cloud)``.
+        """
+        colour = None
+        for topic, msg in messages:
+            if topic.endswith('color/image_raw'):
+                colour = msg
+            elif topic.endswith('camera_info'):
+                self.send_camera_info(msg)
+            else:
+                yield msg, self.send_rgbd(colour, msg)
+
     def send_camera_info(self, msg, timeout=10.0):
         """Publish a camera info and wait until the node holds it (or dropped it)."""
         before = self.node.statistics()['camera_info_dropped']

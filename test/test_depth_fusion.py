@@ -71,18 +71,11 @@ def _replay_bag(tmp_path, scene, frames, encoding, period_ns, **parameters):
     bag = write_message_bag(tmp_path / 'rgbd', entries, 'mcap')
     harness = DetectorHarness(**dict(PARAMETERS, **parameters))
     try:
-        figures, colour, t = [], None, 0
-        for topic, msg in read_message_bag(bag):
-            if topic.endswith('color/image_raw'):
-                colour = msg
-            elif topic.endswith('camera_info'):
-                harness.send_camera_info(msg)
-            else:
-                cloud = harness.send_rgbd(colour, msg)
-                _, depth, person = scene.frame(t)
-                figures.append(_figures(harness, scene, cloud, depth, person))
-                t += 1
-        assert t == frames
+        figures = []
+        for t, (_, cloud) in enumerate(harness.replay_rgbd(read_message_bag(bag))):
+            _, depth, person = scene.frame(t)
+            figures.append(_figures(harness, scene, cloud, depth, person))
+        assert len(figures) == frames
         return np.array(figures), harness.node.statistics()
     finally:
         harness.close()
@@ -248,3 +241,43 @@ def test_the_node_warns_once_when_colour_and_depth_exceed_the_default_segment(mo
         assert len([text for text in logger.warnings if PROFILE_VARIABLE in text]) == 1
     finally:
         harness.close()
+
+
+def test_every_colour_frame_gets_its_mask_when_depth_is_lost_or_stops():
+    scene = WalkAndStop(shape=SHAPE, empty_frames=5, walk_frames=10)
+    harness = DetectorHarness(**PARAMETERS)
+    period = 33_333_333
+    try:
+        harness.send_camera_info(camera_info_message(scene.k, scene.shape, T0))
+        for t in range(3):
+            image, depth_msg, _, _ = _messages(scene, t, '16UC1', period)
+            harness.send_rgbd(image, depth_msg)
+        # Frame 3's depth image is lost: its mask is held for it...
+        image, _, _, _ = _messages(scene, 3, '16UC1', period)
+        masks = len(harness.masks)
+        harness.publisher.publish(image)
+        assert harness.spin_until(lambda: harness.node.statistics()['frames_in'] == 4)
+        assert len(harness.masks) == masks
+        # ... and published, from colour alone, once frame 4's depth shows it has none.
+        image, depth_msg, _, _ = _messages(scene, 4, '16UC1', period)
+        harness.send_rgbd(image, depth_msg)
+        assert harness.spin_until(lambda: len(harness.masks) == masks + 2)
+        assert [_stamp_ns(m) for m in harness.masks[-2:]] == [T0 + 3 * period, T0 + 4 * period]
+        # The depth camera stops: 0.25 s after its last image, masks go out at once,
+        # and so do those held for it meanwhile.
+        for t in range(5, 25):
+            image, _, _, _ = _messages(scene, t, '16UC1', period)
+            harness.publisher.publish(image)
+            assert harness.spin_until(
+                lambda: harness.node.statistics()['frames_in'] == t + 1)
+        assert harness.spin_until(lambda: len(harness.masks) == 25)
+        assert [_stamp_ns(m) for m in harness.masks] == [T0 + t * period for t in range(25)]
+        stats = harness.node.statistics()
+        assert stats['masks_out'] == stats['frames_in'] == 25
+        assert stats['masks_without_depth'] >= 1
+    finally:
+        harness.close()
+
+
+def _stamp_ns(msg):
+    return msg.header.stamp.sec * 10**9 + msg.header.stamp.nanosec

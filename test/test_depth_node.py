@@ -109,19 +109,10 @@ def test_cloud_lies_on_the_body_from_a_rosbag2(tmp_path, scene, encoding, storag
     bag = write_message_bag(tmp_path / 'rgbd', entries, storage)
     harness = DetectorHarness(**PARAMETERS)
     try:
-        figures = []
-        index = 0
-        colour = None
-        for topic, msg in read_message_bag(bag):
-            if topic.endswith('color/image_raw'):
-                colour = msg
-            elif topic.endswith('camera_info'):
-                harness.send_camera_info(msg)
-            else:
-                cloud = harness.send_rgbd(colour, msg)
-                figures.append(_check_outputs(harness, scene, encoding, index, cloud, msg))
-                index += 1
-        assert index == len(scene.frames)
+        figures = [_check_outputs(harness, scene, encoding, index, cloud, msg)
+                   for index, (msg, cloud) in enumerate(harness.replay_rgbd(
+                       read_message_bag(bag)))]
+        assert len(figures) == len(scene.frames)
         _assert_figures(figures, len(scene.frames))
     finally:
         harness.close()

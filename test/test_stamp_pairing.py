@@ -77,3 +77,18 @@ def test_parameters_are_validated():
         StampPairer(slop_ns=-1).validate()
     with pytest.raises(ValueError, match='queue_size'):
         StampPairer(slop_ns=0, queue_size=0).validate()
+
+
+def test_every_dropped_item_is_handed_to_on_drop():
+    dropped = []
+    pairer = StampPairer(slop_ns=5 * MS, queue_size=2,
+                         on_drop=lambda primary, payload: dropped.append((primary, payload)))
+    # Unpaired by stamp, by a full queue, by time going back, and by clear().
+    _feed(pairer, [('c', 0), ('d', 20), ('c', 40), ('c', 73), ('c', 106)])
+    _feed(pairer, [('d', 10)])
+    _feed(pairer, [('c', 200)])
+    pairer.clear()
+    # Time going back drops the newer colour frames newest first.
+    assert dropped == [(True, 'c0'), (False, 'd20'), (True, 'c40'), (True, 'c106'),
+                       (True, 'c73'), (False, 'd10'), (True, 'c200')]
+    assert pairer.unpaired_primary_ == 5 and pairer.unpaired_secondary_ == 2
