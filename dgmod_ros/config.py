@@ -158,8 +158,10 @@ PARAMETERS = (
               'frames or have been away for fewer than still_frames frames (something '
               'passing that the mask missed)',
               active_when={'conditional_update': True, **_PER_PIXEL}),
-    Parameter('absorb_frames', 300, 'foreground older than this many frames enters the '
-              'window as it is (a left object then joins the background)', 1, 1000000,
+    Parameter('absorb_frames', 5400, 'foreground older than this many frames enters the '
+              'window as it is (a left object then joins the background; 5400 = 3 min at 30 '
+              'frames/s: a person who waits stays foreground, the planner decides what is '
+              'parked); the depth background holds a still person as long', 1, 1000000,
               active_when={'conditional_update': True}),
     Parameter('motion_threshold', 0.0, 'frames whose mean absolute change to the last '
               'buffered frame is below this are masked but not buffered; 0 buffers all',

@@ -535,6 +535,14 @@ def main(args=None, kernel_compile=None):
     rclpy.init(args=args)
     node = None
     try:
+        # The solves run in the node's own thread, so the executor only carries
+        # short callbacks. rclpy's MultiThreadedExecutor lost frames of a
+        # 30 frames/s replay here (queue overflow during its stalls; rclpy#1452,
+        # #1223; figures in docs/node.md); the single-threaded one lost none.
+        # Made before the node's (long) start: a Ctrl-C that lands inside an
+        # executor's __init__ leaves a half-made one whose __del__ prints a
+        # traceback at exit (its _sigint_gc never set).
+        executor = SingleThreadedExecutor()
         try:
             node = DetectorNode(kernel_compile=kernel_compile)
         except (ParameterException, ValueError) as error:
@@ -547,11 +555,6 @@ def main(args=None, kernel_compile=None):
             # The failed transition logged its reason, unless a signal
             # stopped the start (a kernel compile interrupted): a normal stop.
             return 1 if rclpy.ok() else 0
-        # The solves run in the node's own thread, so the executor only carries
-        # short callbacks. rclpy's MultiThreadedExecutor lost frames of a
-        # 30 frames/s replay here (queue overflow during its stalls; rclpy#1452,
-        # #1223; figures in docs/node.md); the single-threaded one lost none.
-        executor = SingleThreadedExecutor()
         executor.add_node(node)
         executor.spin()
     except (KeyboardInterrupt, ExternalShutdownException):

@@ -55,7 +55,7 @@ class DepthBackground:
     noise_k : float, default=4.0
         A pixel nearer than the model by more than ``noise_k`` noise levels
         is foreground; within that, at the scene's depth.
-    absorb_frames : int, default=300
+    absorb_frames : int, default=5400
         Readings nearer than the model that a pixel needs before what stands
         there joins the static scene (a parked object): until then a person
         who stands still stays foreground. The node passes its own
@@ -98,7 +98,7 @@ class DepthBackground:
     """
 
     def __init__(self, noise_base=0.002, noise_quadratic=0.005, noise_k=4.0,
-                 absorb_frames=300, learn_frames=10, reveal_frames=5, span_frames=300,
+                 absorb_frames=5400, learn_frames=10, reveal_frames=5, span_frames=300,
                  change_fraction=0.25, compiled=True):
         self.noise_base = noise_base
         self.noise_quadratic = noise_quadratic

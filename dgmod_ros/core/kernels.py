@@ -435,3 +435,5 @@ def _compile_every_kernel():
     compile_texture()                                     # the moving-texture test
     from .streaming.warmup_kernel import compile_kernel as compile_warmup
     compile_warmup()                                      # the masks before the first solve
+    from .depth_kernel import compile_kernel as compile_depth
+    compile_depth()                                       # the depth background (use_depth)

@@ -117,7 +117,7 @@ class SlidingWindowDetector(StreamingDetector):
         Off by default: on a background that moves all the time (leaves) it
         holds out the observations that teach the window the texture's
         spread, and the leaves come through (``docs/results.md``).
-    absorb_frames : int, default=300
+    absorb_frames : int, default=5400
         Foreground older than this many frames is admitted as it is (a left
         object joins the background after about ``absorb_frames + window *
         memory_spacing / 2`` frames).
@@ -230,7 +230,7 @@ class SlidingWindowDetector(StreamingDetector):
     def __init__(self, model=None, window=30, stride=10, scale=0.5, color='rgb',
                  mask_rule=None, motion_threshold=0.0, min_frames=5, basis_rank=2,
                  global_change_fraction=0.7, memory_spacing=10, conditional_update=True,
-                 hold_changes=False, absorb_frames=300, decision='adaptive',
+                 hold_changes=False, absorb_frames=5400, decision='adaptive',
                  noise_source='solve', pixel_k=6.0, median_size=5, ghost_test=True,
                  still_frames=25, mrf_beta=2.0, chroma_cue=True, texture_cue=True,
                  texture_bits=8, moving_texture_k=3.0, moving_texture_bits=16, solve_lag=5,
