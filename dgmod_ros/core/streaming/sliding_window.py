@@ -325,20 +325,11 @@ class SlidingWindowDetector(StreamingDetector):
             self.background_model_ = None
             self.background_pending_ = False
             self.recent_.clear()            # frames of the old size
-            self.foreground_age_ = None
-            self.still_age_ = None
-            self.away_age_ = None
-            self.entered_ = None
-            self.heal_ = None
-            self.healed_ = None
-            self.uncovered_age_ = None
+            self._forget_pixel_histories()
         return self
 
-    def reset(self):
-        """Forget every buffered frame and the background model."""
-        self._new_generation()
-        self.buffer_ = BackgroundMemory(int(self.window), int(self.memory_spacing))
-        self.column_cache_ = ColumnCache()
+    def _forget_pixel_histories(self):
+        """Drop every per-pixel count and mark (a new size, a reset, a scene change)."""
         self.foreground_age_ = None
         self.still_age_ = None
         self.away_age_ = None
@@ -346,6 +337,13 @@ class SlidingWindowDetector(StreamingDetector):
         self.heal_ = None
         self.healed_ = None
         self.uncovered_age_ = None
+
+    def reset(self):
+        """Forget every buffered frame and the background model."""
+        self._new_generation()
+        self.buffer_ = BackgroundMemory(int(self.window), int(self.memory_spacing))
+        self.column_cache_ = ColumnCache()
+        self._forget_pixel_histories()
         self.recent_ = deque(maxlen=_GHOST_LAG)
         self.scene_watch_ = SceneChangeWatch()
         self.background_model_ = None
@@ -536,13 +534,7 @@ class SlidingWindowDetector(StreamingDetector):
         for frame_id, columns in list(self.recent_)[-count:]:
             self.buffer_.append(columns, frame_id)
         self.since_solve_ = len(self.buffer_)
-        self.foreground_age_ = None
-        self.still_age_ = None
-        self.away_age_ = None
-        self.entered_ = None
-        self.heal_ = None
-        self.healed_ = None
-        self.uncovered_age_ = None
+        self._forget_pixel_histories()
         self.background_model_ = None
         self.background_pending_ = False
         self.scene_changes_ += 1
