@@ -28,7 +28,7 @@ from dgmod_ros.sequence import results
 import numpy as np
 
 sys.path.insert(0, str(__import__('pathlib').Path(__file__).resolve().parent))
-from eval_sequences import DATA, SEQUENCES  # noqa: E402
+from eval_sequences import DATA, SEQUENCES  # noqa: E402, I100
 
 
 def fingerprint(name, mode, max_frames):
