@@ -19,7 +19,7 @@ $(STAMP): requirements.txt setup.py
 # the GIL); compiling them here, into the on-disk cache, keeps that out of
 # the demo's first start and out of the tests' time-outs (docs/node.md,
 # "First start"). A warm cache makes this a two-second load.
-KERNELS := $(PY) -m dgmod_ros.core.kernel_cache
+KERNELS := $(PY) -m dgmod_ros.core.warmup
 
 demo: $(STAMP)
 	$(KERNELS)

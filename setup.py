@@ -45,7 +45,7 @@ class install_kernels(Command):
         library = os.path.abspath(self.install_dir)
         seed = os.path.join(library, package_name, 'kernel_seed')
         code = ('import sys; sys.path.insert(0, {!r}); '
-                'from dgmod_ros.core.kernel_cache import main; sys.exit(main())').format(library)
+                'from dgmod_ros.core.warmup import main; sys.exit(main())').format(library)
         print(f'install_kernels: compiling the kernels into {seed} (30-60 s on two cores)')
         start = time.monotonic()
         done = subprocess.run([sys.executable, '-P', '-c', code],

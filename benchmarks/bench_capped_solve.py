@@ -28,7 +28,7 @@ from dataclasses import replace
 import time
 
 from dgmod_ros import config
-from dgmod_ros.core.kernels import use_threads
+from dgmod_ros.core.numba_setup import use_threads
 from dgmod_ros.core.preprocess import frame_columns
 from dgmod_ros.core.streaming import solve_resolution, window_solve
 from dgmod_ros.core.streaming.results import WindowSnapshot

@@ -20,10 +20,10 @@ from dgmod_ros import config
 from dgmod_ros.core.depth import (back_project, depth_in_metres, invalidate_background,
                                   PinholeIntrinsics)
 from dgmod_ros.core.depth_background import DepthBackground, fuse_masks
-from dgmod_ros.core.depth_kernel import compile_kernel
-from dgmod_ros.core.kernels import compile_all
+from dgmod_ros.core.kernels.depth_background import compile_kernel
 from dgmod_ros.core.synthetic import synthetic_rgbd_scene
 from dgmod_ros.core.synthetic_depth import WalkAndStop
+from dgmod_ros.core.warmup import compile_all
 from dgmod_ros.image_conversion import array_to_image_fields, depth_image_to_array
 from dgmod_ros.point_cloud import point_cloud_fields
 import numpy as np

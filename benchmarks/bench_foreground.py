@@ -20,11 +20,13 @@ import cv2
 from dgmod_ros import config
 from dgmod_ros.core.preprocess import frame_columns
 from dgmod_ros.core.streaming.background_memory import conditional_columns
+from dgmod_ros.core.streaming.decision import adaptive_mask, moving_texture_k
 from dgmod_ros.core.streaming.fast_path import projection_residual, robust_projection
-from dgmod_ros.core.streaming.foreground import (adaptive_mask, consecutive_frames, ghost_blobs,
-                                                 moving_texture_k, pixel_noise, to_input_size)
-from dgmod_ros.core.streaming.held_foreground import still_blob_pixels
+from dgmod_ros.core.streaming.ghost import ghost_blobs
+from dgmod_ros.core.streaming.held_foreground import consecutive_frames, still_blob_pixels
+from dgmod_ros.core.streaming.noise_levels import pixel_noise
 from dgmod_ros.core.streaming.photometric import chroma_noise
+from dgmod_ros.core.streaming.upsizing import to_input_size
 from dgmod_ros.core.synthetic import synthetic_scene
 import numpy as np
 from timing import median_ms

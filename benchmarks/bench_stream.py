@@ -22,7 +22,7 @@ import time
 
 import cv2
 from dgmod_ros import cli, config
-from dgmod_ros.core.kernels import use_threads
+from dgmod_ros.core.numba_setup import use_threads
 from dgmod_ros.core.synthetic import synthetic_scene
 from dgmod_ros.inputs import read_frames
 

@@ -551,7 +551,7 @@ def load_kernels(values, log=None, pending=None, should_stop=None):
     if detector_class(values) is SlidingWindowDetector:
         from .core.kernel_cache import ensure_ready
         ensure_ready(log or _say_on_stderr, pending, should_stop)
-        from .core.kernels import compile_all       # numba: imported when needed
+        from .core.warmup import compile_all        # numba: imported when needed
         compile_all()
 
 

@@ -40,7 +40,7 @@ from sensor_msgs.msg import CameraInfo, Image, PointCloud2, PointField
 from .core.depth import (back_project, depth_in_metres, invalidate_background, mask_to_shape,
                          PinholeIntrinsics)
 from .core.depth_background import DepthBackground, fuse_masks
-from .core.depth_kernel import compile_kernel as compile_depth_kernel
+from .core.kernels.depth_background import compile_kernel as compile_depth_kernel
 from .image_conversion import (depth_image_to_array, fill_image, ImageConversionError,
                                stamp_ns)
 from .point_cloud import point_cloud_fields

@@ -39,8 +39,8 @@ from sensor_msgs.msg import CompressedImage, Image
 from std_srvs.srv import Trigger
 
 from . import config
-from .core.kernels import use_threads
 from .core.masks import overlay
+from .core.numba_setup import use_threads
 from .core.preprocess import to_float_channels, to_uint8
 from .core.runtime import keep_freed_memory, yield_to_compute
 from .core.streaming import SolverFailure

@@ -7,7 +7,7 @@ from concurrent.futures import ThreadPoolExecutor
 import cv2
 
 from . import config
-from .core.kernels import use_threads
+from .core.numba_setup import use_threads
 from .core.pipeline import batch_separate
 
 

@@ -7,10 +7,11 @@ from dgmod_ros.core.streaming import SlidingWindowDetector
 from dgmod_ros.core.streaming.background_memory import BackgroundMemory, held_pixels
 from dgmod_ros.core.streaming.blobs import BlobMotion
 from dgmod_ros.core.streaming.coherence import mean_field_mask
+from dgmod_ros.core.streaming.decision import adaptive_mask, moving_texture_k
 from dgmod_ros.core.streaming.fast_path import projection_residual, robust_projection
-from dgmod_ros.core.streaming.foreground import (adaptive_mask, consecutive_frames,
-                                                 moving_texture_k, pixel_noise, warmup_noise)
-from dgmod_ros.core.streaming.held_foreground import came_in, moved_inside, still_blob_pixels
+from dgmod_ros.core.streaming.held_foreground import (came_in, consecutive_frames, moved_inside,
+                                                      still_blob_pixels)
+from dgmod_ros.core.streaming.noise_levels import pixel_noise, warmup_noise
 from dgmod_ros.core.streaming.window_solve import healed_starts
 import numpy as np
 import pytest

@@ -175,10 +175,10 @@ def test_the_node_loads_its_compiled_kernels_before_the_first_frame():
     script = (
         'import json, sys\n'
         'sys.path.insert(0, "test")\n'
-        'from dgmod_ros.core import kernels\n'
-        'from dgmod_ros.core.streaming import lighting_kernel, mean_field_kernel\n'
+        'from dgmod_ros.core.kernels import dgmod\n'
+        'from dgmod_ros.core.streaming.kernels import coherence, photometric\n'
         'from ros_harness import DetectorHarness\n'
-        'kernels_run = (kernels.primal_pass, lighting_kernel._explain, mean_field_kernel._sweep)\n'
+        'kernels_run = (dgmod.primal_pass, photometric._explain, coherence._sweep)\n'
         'before = [len(k.signatures) for k in kernels_run]\n'
         'harness = DetectorHarness()\n'
         'try:\n'

@@ -63,7 +63,7 @@ def test_the_ready_mark_holds_for_its_install_only(tmp_path):
 
 def test_a_compile_in_process_marks_the_cache_ready():
     # make test compiles the kernels before the tests: this process loads them.
-    from dgmod_ros.core.kernels import compile_all
+    from dgmod_ros.core.warmup import compile_all
     compile_all()
     assert kernel_cache.is_ready()
     mark = json.loads(kernel_cache.ready_path().read_text())

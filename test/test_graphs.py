@@ -1,9 +1,9 @@
 # Copyright 2026 dgmod_ros authors
 # Licensed under the Apache License, Version 2.0
-from dgmod_ros.core.graph_kernel import neighbour_square_sums
 from dgmod_ros.core.graphs import (banded_matrix, diagonal_bands, normalized_laplacian,
                                    spatial_laplacian, spatial_laplacian_bands,
                                    temporal_laplacian)
+from dgmod_ros.core.kernels.graphs import neighbour_square_sums
 from dgmod_ros.core.linalg import gram_matrix
 import numpy as np
 import pytest

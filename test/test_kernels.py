@@ -11,9 +11,10 @@ import sys
 import threading
 import types
 
-from dgmod_ros.core import kernels
+from dgmod_ros.core import kernel_cache
 from dgmod_ros.core.dgmod import DualGraphMOD
-from dgmod_ros.core.linalg import c_order, gram_matrix
+from dgmod_ros.core.kernels import dgmod as kernels
+from dgmod_ros.core.linalg import c_order, frames_major, gram_matrix
 from dgmod_ros.core.runtime import limit_blas_threads
 from dgmod_ros.core.synthetic import synthetic_scene
 import numba
@@ -177,7 +178,7 @@ def test_kernels_run_from_two_threads_at_once():
 
 def test_cache_folder_defaults_to_the_user_cache(monkeypatch, tmp_path):
     monkeypatch.setenv('XDG_CACHE_HOME', str(tmp_path))
-    assert kernels.default_cache_dir() == str(tmp_path / 'dgmod_ros' / 'numba')
+    assert kernel_cache.default_cache_dir() == str(tmp_path / 'dgmod_ros' / 'numba')
     assert numba.config.CACHE_DIR       # set before the first compiled call
     assert numba.config.THREADING_LAYER == 'threadsafe'
 
@@ -217,7 +218,7 @@ def test_blas_libraries_are_read_again_only_after_an_import(monkeypatch):
 
 
 def test_threading_layer_survives_numba_imported_first(tmp_path):
-    # A module that imports numba before dgmod_ros.core.kernels, then a
+    # A module that imports numba before dgmod_ros.core.numba_setup, then a
     # compile: numba re-reads its configuration from the environment, which
     # must keep the threadsafe layer (the node calls kernels from two threads).
     script = (
@@ -225,7 +226,7 @@ def test_threading_layer_survives_numba_imported_first(tmp_path):
         'os.environ.pop("NUMBA_THREADING_LAYER", None)\n'
         'os.environ.pop("NUMBA_CACHE_DIR", None)\n'
         'import numba\n'
-        'from dgmod_ros.core import kernels\n'
+        'from dgmod_ros.core import numba_setup\n'
         '@numba.njit\n'
         'def one_more(x):\n'
         '    return x + 1\n'
@@ -244,7 +245,7 @@ _LATE_COMPILES = """
 import sys
 from numba.core.registry import CPUDispatcher
 from dgmod_ros import config
-from dgmod_ros.core.kernels import compile_all
+from dgmod_ros.core.warmup import compile_all
 from dgmod_ros.core.synthetic import synthetic_scene
 import numpy as np
 
@@ -285,10 +286,10 @@ def test_compile_all_covers_every_kernel_the_detector_calls():
 
 def test_frames_major_and_c_order_are_transposes_without_needless_copies():
     matrix = scene_window()
-    frames = kernels.frames_major(matrix)
+    frames = frames_major(matrix)
     assert frames.flags.c_contiguous and np.array_equal(frames, matrix.T)
     # The solver's F-ordered state: its transpose is the frames-major array itself.
-    assert np.shares_memory(kernels.frames_major(frames.T), frames)
+    assert np.shares_memory(frames_major(frames.T), frames)
     for source in (matrix, frames.T, matrix[::2]):      # C, F, strided
         ordered = c_order(source)
         assert ordered.flags.c_contiguous and np.array_equal(ordered, source)

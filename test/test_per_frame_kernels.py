@@ -4,15 +4,17 @@
 
 import cv2
 from dgmod_ros.core.preprocess import frame_columns, to_float_channels
-from dgmod_ros.core.streaming import lighting_kernel, mean_field_kernel, warmup_kernel
 from dgmod_ros.core.streaming.blobs import BlobMotion, moving_share_reference
 from dgmod_ros.core.streaming.coherence import mean_field_mask, mean_field_mask_reference
-from dgmod_ros.core.streaming.foreground import (_edge_strength, ghost_blobs, ghost_labels,
-                                                 observed_median, to_input_size,
-                                                 warmup_noise)
+from dgmod_ros.core.streaming.ghost import _edge_strength, ghost_blobs, ghost_labels
 from dgmod_ros.core.streaming.held_foreground import still_blob_pixels
-from dgmod_ros.core.streaming.lighting_kernel import explained_pixels
+from dgmod_ros.core.streaming.kernels import coherence as mean_field_kernel
+from dgmod_ros.core.streaming.kernels import photometric as lighting_kernel
+from dgmod_ros.core.streaming.kernels import warmup_background as warmup_kernel
+from dgmod_ros.core.streaming.kernels.photometric import explained_pixels
+from dgmod_ros.core.streaming.noise_levels import observed_median, warmup_noise
 from dgmod_ros.core.streaming.photometric import distortion, LightingTest
+from dgmod_ros.core.streaming.upsizing import to_input_size
 import numpy as np
 import pytest
 
@@ -179,7 +181,7 @@ def test_lighting_kernel_gives_the_reference_answers(seed):
         test = LightingTest(*cues, texture_bits=int(rng.integers(0, 12)))
         args = (frame, background, noise, 6.0, (rows, cols, 3), candidates, chroma_level)
         assert np.array_equal(test.explains(*args), test.explains_reference(*args))
-        assert explained_pixels(test, *args) is not None
+        assert explained_pixels(*args, *cues, test.texture_bits) is not None
 
 
 @pytest.mark.parametrize('dtype', [np.uint8, np.uint16, np.float32, np.float64])

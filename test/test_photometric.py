@@ -3,9 +3,9 @@
 """The lighting test of the per-pixel decision: shadows and reflections are not people."""
 
 from dgmod_ros.core.streaming import SlidingWindowDetector
-from dgmod_ros.core.streaming.foreground import adaptive_mask
+from dgmod_ros.core.streaming.decision import adaptive_mask
+from dgmod_ros.core.streaming.kernels.texture import descriptor_distance, PATTERN
 from dgmod_ros.core.streaming.photometric import distortion, LightingTest
-from dgmod_ros.core.streaming.texture import descriptor_distance, PATTERN
 import numpy as np
 import pytest
 

@@ -8,11 +8,11 @@ from dataclasses import replace
 import cv2
 from dgmod_ros import config
 from dgmod_ros.core.dgmod import DualGraphMOD
-from dgmod_ros.core.kernels import use_threads
 from dgmod_ros.core.masks import MaskRule
-from dgmod_ros.core.streaming.carry_kernel import normal_equations
+from dgmod_ros.core.numba_setup import use_threads
 from dgmod_ros.core.streaming.fast_path import background_basis
-from dgmod_ros.core.streaming.foreground import pixel_noise
+from dgmod_ros.core.streaming.kernels.solve_resolution import normal_equations
+from dgmod_ros.core.streaming.noise_levels import pixel_noise
 from dgmod_ros.core.streaming.photometric import chroma_noise
 from dgmod_ros.core.streaming.results import WindowSnapshot
 from dgmod_ros.core.streaming.solve_resolution import (carry_backgrounds, ColumnCache,

@@ -25,7 +25,7 @@ fixed number of subpixels makes depth noise grow with z squared).
 
 import numpy as np
 
-from . import depth_kernel
+from .kernels import depth_background as depth_kernel
 
 #: Verdicts of :meth:`DepthBackground.update`, one uint8 per pixel.
 UNKNOWN, BACKGROUND, FOREGROUND = np.uint8(0), np.uint8(1), np.uint8(2)
@@ -73,7 +73,7 @@ class DepthBackground:
         one frame, restarts it (the camera moved: a person can hide the scene
         but never put it farther away); 1.0 disables.
     compiled : bool, default=True
-        Run the update as two compiled passes (:mod:`dgmod_ros.core.depth_kernel`);
+        Run the update as two compiled passes (:mod:`dgmod_ros.core.kernels.depth_background`);
         False runs its numpy reference (the same results, bit for bit).
 
     Attributes

@@ -8,8 +8,9 @@ import numpy as np
 
 from .graphs import (banded_matrix, diagonal_bands, spatial_laplacian_bands,
                      temporal_laplacian)
-from .linalg import (drop_oldest, gram_eigh, gram_matrix, mixing_factors, relative_change,
-                     row_median, shrink, singular_value_map, top_singular_value)
+from .linalg import (drop_oldest, frames_major, gram_eigh, gram_matrix, mixing_factors,
+                     relative_change, row_median, shrink, singular_value_map,
+                     top_singular_value)
 from .runtime import limit_blas_threads
 from .window_data import check_window_data
 
@@ -123,7 +124,7 @@ class DualGraphMOD:
         LAPACK on the tall matrix (the literal reference).
     engine : {'fused', 'numpy'}, default='fused'
         'fused' runs a sweep as one compiled, multi-threaded pass and the
-        BLAS products of the SVT (:mod:`dgmod_ros.core.kernels`); 'numpy' is
+        BLAS products of the SVT (:mod:`dgmod_ros.core.kernels.dgmod`); 'numpy' is
         the literal formulation, one numpy expression per step, which the
         tests compare it with. Both give the same iterates to float32
         rounding. ``svd='full'`` (the literal reference) always runs the
@@ -379,7 +380,7 @@ class DualGraphMOD:
 
     def _run_fused(self, data, ops, iterates, history, data_norm):
         """
-        Sweep with the compiled pass of :mod:`dgmod_ros.core.kernels`.
+        Sweep with the compiled pass of :mod:`dgmod_ros.core.kernels.dgmod`.
 
         The same steps as :meth:`_run_numpy` in the same order, the same
         iterates and the same stopping sweep. The primal pass also sums the
@@ -387,25 +388,25 @@ class DualGraphMOD:
         ``U = (Lh left) right_t`` block by block from its rank-k factors; BLAS
         forms the whole product only where ``U`` itself is read (the stopping
         test, a numpy L-step, the state handed back). ``Y1`` lives as
-        ``U - Lh`` (kernels module docstring) and is formed once, at the end.
+        ``U - Lh`` (kernels.dgmod's docstring) and is formed once, at the end.
         The pass runs on the frames-major transposes of the iterates
-        (:func:`kernels.frames_major`); the iterates handed back are ``n x m``
+        (:func:`~dgmod_ros.core.linalg.frames_major`); the iterates handed back are ``n x m``
         views of them (F-ordered), so a warm start from them needs no
         transpose. The given L, S, U and Y1 are read, never written: the
         caller's state needs no copy.
         """
-        from . import kernels       # numba compiles or loads its cache on first use
+        from .kernels import dgmod as kernels   # numba compiles or loads its cache on first use
         # Again at every solve: an OpenBLAS loaded since (scipy.linalg's) must
-        # not spin beside the kernels either (kernels module docstring).
+        # not spin beside the kernels either (numba_setup's docstring).
         limit_blas_threads(1)
 
-        D = kernels.frames_major(data)
+        D = frames_major(data)
         # L, S and U are read only (the given ones may be the caller's
         # state); V and Y2 are updated in place, so the pass gets copies.
-        L, S, U = (kernels.frames_major(iterates[k]) for k in ('L', 'S', 'U'))
-        V, Y2 = (kernels.frames_major(iterates[k]).copy() for k in ('V', 'Y2'))
+        L, S, U = (frames_major(iterates[k]) for k in ('L', 'S', 'U'))
+        V, Y2 = (frames_major(iterates[k]).copy() for k in ('V', 'Y2'))
         given_L = L                 # the first sweep swaps it, and the given S, out
-        Lh = U - kernels.frames_major(iterates['Y1'])   # so that U - Lh is the given Y1
+        Lh = U - frames_major(iterates['Y1'])   # so that U - Lh is the given Y1
         # After a sweep's SVT, U = (left right_t)^T Lh is kept as its factors:
         # the next pass forms it block by block (kernels.primal_pass), and the
         # n x m product is formed only where U itself is read.
@@ -577,9 +578,8 @@ class DualGraphMOD:
         if fused:
             # The compiled pass runs frames-major; ``data`` becomes an n x m
             # view of the transpose, so that the state's arithmetic below
-            # runs in one memory order (kernels.frames_major).
-            from . import kernels
-            data = kernels.frames_major(data).T
+            # runs in one memory order (linalg.frames_major).
+            data = frames_major(data).T
         state = self._initial_state(data) if init is None else replace(init)
         # The numpy steps update every iterate in place, so they start from
         # copies, in the state's own memory order (a copy of the fused

@@ -137,7 +137,7 @@ def spatial_laplacian_bands(data, frame_shape, patch_size=3, h=None, smoothing_s
     m = data.shape[1]
     n = n1 * n2
     # Frames-major (m, n1, n2): free for the fused solver's window, whose
-    # memory is already in that order (kernels.frames_major).
+    # memory is already in that order (linalg.frames_major).
     frames = c_order(np.asarray(data, dtype=np.float32).T).reshape(m, n1, n2)
     if smoothing_sigma > 0:
         frames = ndimage.gaussian_filter(frames, sigma=(0, smoothing_sigma, smoothing_sigma),
@@ -147,7 +147,7 @@ def spatial_laplacian_bands(data, frame_shape, patch_size=3, h=None, smoothing_s
     if not directions:
         return (np.zeros(1, dtype=np.int64), np.zeros((1, n), dtype=np.float32),
                 1.0 if h is None else float(h))
-    from .graph_kernel import neighbour_square_sums     # numba: imported on first use
+    from .kernels.graphs import neighbour_square_sums     # numba: imported on first use
     sums = dict(zip((1, 0), neighbour_square_sums(frames)))
     dists = [_box_sum(sums[axis], patch_size) for axis, _ in directions]
     weights, h_used = _gaussian_weights(

@@ -3,14 +3,14 @@
 """
 Where the compiled kernels live, whether they are there, and how they get there without a stall.
 
-numba compiles the kernels of :mod:`~dgmod_ros.core.kernels` and the
-per-frame modules once and keeps them in a disk cache; a cold compile takes
+numba compiles the package's compiled passes (``dgmod_ros/core/kernels/``,
+``dgmod_ros/core/streaming/kernels/``) once and keeps them in a disk cache; a cold compile takes
 30-60 s on two cores and holds the GIL, so it must not happen in a process
 that is meant to answer a user or a camera (docs/node.md, "First start").
 
 - **The cache folder** is ``$NUMBA_CACHE_DIR``, else
   ``$XDG_CACHE_HOME/dgmod_ros/numba``, else ``~/.cache/dgmod_ros/numba``
-  (:func:`cache_dir`; :mod:`~dgmod_ros.core.kernels` sets
+  (:func:`cache_dir`; :mod:`~dgmod_ros.core.numba_setup` sets
   ``NUMBA_CACHE_DIR`` to it before numba reads its configuration). numba
   keys an entry by the source file's absolute path, its mtime and size, the
   numba version and the CPU: an entry is valid only for the installed files
@@ -22,7 +22,7 @@ that is meant to answer a user or a camera (docs/node.md, "First start").
   are missing or older, so a fresh home folder, or a read-only install
   prefix, loads them instead of compiling.
 - **The ready mark.** :func:`mark_ready` (the end of
-  :func:`~dgmod_ros.core.kernels.compile_all`) writes one small file per
+  :func:`~dgmod_ros.core.warmup.compile_all`) writes one small file per
   installed package into the cache folder holding :func:`cache_key`: the
   sources' paths, mtimes and sizes, the numba and Python versions and the
   CPU. :func:`is_ready` compares it with the running install's key, so a
@@ -41,7 +41,6 @@ import os
 from pathlib import Path
 import platform
 import shutil
-import signal
 import subprocess
 import sys
 import tempfile
@@ -227,7 +226,7 @@ class ChildCompile:
         # cache by their paths): the package's parent folder first, and no
         # current folder (-P).
         code = ('import sys; sys.path.insert(0, {!r}); '
-                'from dgmod_ros.core.kernel_cache import child_main; child_main()').format(
+                'from dgmod_ros.core.warmup import child_main; child_main()').format(
                     str(PACKAGE_DIR.parent))
         env = dict(os.environ, NUMBA_CACHE_DIR=cache_dir())
         self.started = time.monotonic()
@@ -326,30 +325,3 @@ def ensure_ready(log=None, pending=None, should_stop=None):
         return 0.0
     say(f'kernels compiled in {seconds:.0f} s (cached in {cache_dir()})')
     return seconds
-
-
-def main():
-    """
-    Compile (or load) every kernel into the cache, then mark it ready.
-
-    ``python3 -m dgmod_ros.core.kernel_cache`` does it ahead of a first
-    start; ``setup.py``'s ``install_kernels`` runs it on the installed files.
-    Returns the exit status (130 after Ctrl-C, which a cold compile may take
-    seconds to notice).
-    """
-    from .kernels import compile_all
-    try:
-        compile_all()
-    except KeyboardInterrupt:
-        return 130
-    return 0
-
-
-def child_main():
-    """Run :func:`main` as :class:`ChildCompile`'s child: SIGINT is its caller's to handle."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    sys.exit(main())
-
-
-if __name__ == '__main__':
-    sys.exit(main())

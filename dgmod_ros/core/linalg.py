@@ -25,12 +25,12 @@ def gram_matrix(matrix):
 
     A float32 matrix whose transpose is C-contiguous (the fused solver's
     frames-major windows and states) goes to the compiled
-    :func:`~dgmod_ros.core.kernels.frames_gram`, faster on one thread than
+    :func:`~dgmod_ros.core.kernels.dgmod.frames_gram`, faster on one thread than
     BLAS here; anything else to BLAS.
     """
     rows = matrix.T
     if matrix.ndim == 2 and matrix.dtype == np.float32 and rows.flags.c_contiguous:
-        from .kernels import frames_gram        # numba: imported on first use
+        from .kernels.dgmod import frames_gram      # numba: imported on first use
         return frames_gram(rows)
     return (matrix.T @ matrix).astype(np.float64)
 
@@ -121,7 +121,7 @@ def c_order(matrix):
     Return a 2-D float32 array in C order, by OpenCV's blocked transpose when it is F-ordered.
 
     The fused solver's iterates are F-ordered (``n x m`` views of frames-major
-    arrays, :func:`~dgmod_ros.core.kernels.frames_major`); numpy's strided
+    arrays, :func:`frames_major`); numpy's strided
     transpose of such a tall matrix took ten times as long as a copy, and
     OpenCV's about twice (docs/solver.md).
     """
@@ -131,6 +131,18 @@ def c_order(matrix):
     if matrix.flags.f_contiguous:
         return cv2.transpose(matrix.T)
     return np.ascontiguousarray(matrix)
+
+
+def frames_major(matrix):
+    """
+    Return the ``(m, n)`` C-contiguous transpose of a float32 window ``matrix`` (n, m).
+
+    The layout of the fused solver's compiled pass
+    (:func:`~dgmod_ros.core.kernels.dgmod.primal_pass`). No copy when
+    ``matrix`` already is such a transpose (an F-ordered ``n x m`` array, as
+    the fused solver's state is); else a blocked transpose (:func:`c_order`).
+    """
+    return c_order(np.asarray(matrix, dtype=np.float32).T)
 
 
 def row_median(matrix):

@@ -116,7 +116,7 @@ def frame_columns(frame, scale, color='gray', channel_order='rgb', value_range=N
         # A colour camera at scale 0.5: the same columns in one pass (halving_kernel).
         full_scale = unit_scale(frame.dtype) if value_range is None else float(value_range)
         if full_scale > 0:
-            from .halving_kernel import half_columns        # numba: loaded on first use
+            from .kernels.preprocess import half_columns        # numba: loaded on first use
             return (half_columns(frame, np.float32(1.0 / full_scale), channel_order == 'bgr'),
                     (rows, cols, 3))
     channels = to_float_channels(frame, channel_order, color, value_range)

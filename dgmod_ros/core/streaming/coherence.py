@@ -51,7 +51,7 @@ def mean_field_mask(distance, noise, k, beta, shape, sweeps=SWEEPS, radius=RADIU
     Return the foreground (rows, cols) uint8 0/255 of the Potts field over the k-sigma rule.
 
     The sweeps of :func:`mean_field_mask_reference`, compiled
-    (:mod:`~dgmod_ros.core.streaming.mean_field_kernel`): the same masks bit
+    (:mod:`~dgmod_ros.core.streaming.kernels.coherence`): the same masks bit
     for bit, falling back to the reference where the kernel cannot promise it.
 
     Parameters
@@ -73,7 +73,7 @@ def mean_field_mask(distance, noise, k, beta, shape, sweeps=SWEEPS, radius=RADIU
         Neighbourhood radius ``r`` (square of side ``2 r + 1``).
 
     """
-    from .mean_field_kernel import mean_field_spins     # numba: loaded on first use
+    from .kernels.coherence import mean_field_spins     # numba: loaded on first use
     rows, cols = shape[:2]
     spin = mean_field_spins(distance, noise, k, beta, rows, cols, sweeps, radius, _Z_CAP,
                             _LOGIT_CAP)

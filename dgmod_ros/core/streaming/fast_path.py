@@ -56,7 +56,7 @@ def robust_projection(basis, columns, fit_pixels=None, fit_basis=None):
 
     The same iterations as :func:`robust_projection_reference`, with each
     sweep's weighted normal equations formed in one compiled pass
-    (:mod:`~dgmod_ros.core.streaming.irls_kernel`, float64 sums) instead of
+    (:mod:`~dgmod_ros.core.streaming.kernels.fast_path`, float64 sums) instead of
     five numpy passes. The sweeps start from the least-squares coefficients
     of every pixel and weigh every ``fit_step``-th pixel only; the returned
     projection is of every pixel.
@@ -73,7 +73,7 @@ def robust_projection(basis, columns, fit_pixels=None, fit_basis=None):
         ``sampled_basis(basis, fit_pixels)`` where the caller keeps it; None forms it.
 
     """
-    from .irls_kernel import weighted_normal_equations    # numba: loaded on first use
+    from .kernels.fast_path import weighted_normal_equations    # numba: loaded on first use
     basis = np.ascontiguousarray(basis, dtype=np.float32)
     columns = np.ascontiguousarray(columns, dtype=np.float32)
     channels, n, rank = basis.shape

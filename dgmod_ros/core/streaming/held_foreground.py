@@ -9,7 +9,7 @@ foreground. Its blind spot is a ghost: something that was in the window's
 frames when the model was learnt (a person standing in the first frames)
 leaves, the place it uncovers is foreground, and being foreground it is never
 admitted, so the window keeps the departed object until ``absorb_frames``
-pass. The ghost test of :func:`~dgmod_ros.core.streaming.foreground.ghost_blobs`
+pass. The ghost test of :func:`~dgmod_ros.core.streaming.ghost.ghost_blobs`
 catches a ghost whose outline is an edge of the background; one that
 uncovers texture (a railing behind a plain sweater) has the stronger edges
 in the frame and passes for an object.
@@ -101,3 +101,16 @@ def still_blob_pixels(mask, frame, earlier, noise, k, share, blobs=None, entered
     if entered is not None and still.any():
         still &= ~came_in(blobs, entered)
     return blobs.pixels(still)
+
+
+def consecutive_frames(previous, flags):
+    """
+    Return for each pixel the consecutive frames (n,) int32 its flag has held.
+
+    ``previous`` is the count of the frame before (None or another shape:
+    start from zero); a pixel whose flag is off restarts at 0.
+    """
+    flags = np.asarray(flags).ravel()
+    if previous is None or previous.shape != flags.shape:
+        previous = np.zeros(flags.shape, dtype=np.int32)
+    return np.where(flags, previous + 1, 0).astype(np.int32)

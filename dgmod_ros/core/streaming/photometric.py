@@ -22,9 +22,9 @@ light when all the enabled cues agree:
   :func:`~dgmod_ros.core.streaming.foreground.pixel_noise` reads the level of
   the channel-wise difference);
 - texture: the LBSP descriptor distance to the background
-  (:mod:`~dgmod_ros.core.streaming.texture`) at most ``texture_bits``;
+  (:mod:`~dgmod_ros.core.streaming.kernels.texture`) at most ``texture_bits``;
 - brightness: ``|alpha - 1|`` within LBSP's relative threshold
-  (:data:`~dgmod_ros.core.streaming.texture.RELATIVE_THRESHOLD`), the one
+  (:data:`~dgmod_ros.core.streaming.kernels.texture.RELATIVE_THRESHOLD`), the one
   share of a value below which both cues call two values similar.
 
 References
@@ -37,8 +37,8 @@ Workshop, 1999.
 
 import numpy as np
 
-from .foreground import magnitude_noise
-from .texture import descriptor_distance, RELATIVE_THRESHOLD
+from .kernels.texture import descriptor_distance, RELATIVE_THRESHOLD
+from .noise_levels import magnitude_noise
 
 # Smallest squared background norm: a black pixel has no chromaticity.
 _DARK = 1e-6
@@ -89,7 +89,7 @@ def chroma_noise(data, residual, shape, observed=None, uniform=False, sample=Non
         (:func:`~dgmod_ros.core.streaming.foreground.pixel_noise`); None: every pixel.
 
     """
-    from .lighting_kernel import window_chroma     # numba: loaded on first use
+    from .kernels.photometric import window_chroma     # numba: loaded on first use
     chroma = window_chroma(data, residual)
     if chroma is None:
         _, chroma = distortion(data, data - residual)
@@ -144,13 +144,13 @@ class LightingTest:
         Notes
         -----
         Computed in one compiled pass over the candidates
-        (:mod:`~dgmod_ros.core.streaming.lighting_kernel`), with the answers
+        (:mod:`~dgmod_ros.core.streaming.kernels.photometric`), with the answers
         of :meth:`explains_reference` bit for bit.
 
         """
-        from .lighting_kernel import explained_pixels     # numba: loaded on first use
-        explained = explained_pixels(self, columns, background, noise, k, shape, candidates,
-                                     chroma_level)
+        from .kernels.photometric import explained_pixels     # numba: loaded on first use
+        explained = explained_pixels(columns, background, noise, k, shape, candidates,
+                                     chroma_level, self.chroma, self.texture, self.texture_bits)
         if explained is None:
             return self.explains_reference(columns, background, noise, k, shape, candidates,
                                            chroma_level)

@@ -16,15 +16,17 @@ from .background_memory import BackgroundMemory, conditional_columns, held_pixel
 from .blobs import BlobMotion
 from .buffer import SceneChangeWatch
 from .contract import StreamingDetector
+from .decision import adaptive_mask
 from .fast_path import robust_projection
-from .foreground import (adaptive_mask, consecutive_frames, ghost_labels, to_input_size,
-                         warmup_noise)
-from .held_foreground import moved_inside, still_blob_pixels
+from .ghost import ghost_labels
+from .held_foreground import consecutive_frames, moved_inside, still_blob_pixels
+from .kernels.warmup_background import entry_medians
+from .noise_levels import warmup_noise
 from .photometric import LightingTest
 from .results import FrameResult, WindowSnapshot
 from .settings import assign_validated, check_window_parameters
 from .solve_resolution import ColumnCache, solve_shape
-from .warmup_kernel import entry_medians
+from .upsizing import to_input_size
 from .window_solve import solve_window
 from ..dgmod import DualGraphMOD
 from ..masks import MaskRule

@@ -21,9 +21,9 @@ of the solve, where at full size it had cost more than the solve itself.
 import cv2
 import numpy as np
 
-from .carry_kernel import normal_equations
 from .fast_path import background_basis
-from .foreground import magnitude_noise
+from .kernels.solve_resolution import normal_equations
+from .noise_levels import magnitude_noise
 from ..linalg import thin_svd
 
 # Most channels one cv2.resize call takes: OpenCV 5's CV_CN_MAX, and 4 for
@@ -103,7 +103,7 @@ def downsample_window(data, shape, small_shape):
 
     Each channel of the result is F-ordered, an ``n x m`` view of its
     frames-major ``(m, n)`` rows: what the fused solver works on
-    (:func:`~dgmod_ros.core.kernels.frames_major`), so that it copies nothing.
+    (:func:`~dgmod_ros.core.linalg.frames_major`), so that it copies nothing.
     """
     small = np.stack([resample_frames(channel.T, shape, small_shape, cv2.INTER_AREA)
                       for channel in data])                                # (C, m, n')

@@ -9,7 +9,7 @@ import cv2
 import numpy as np
 
 from .fast_path import background_basis, projection_residual, sampled_basis
-from .foreground import pixel_noise
+from .noise_levels import pixel_noise
 from .photometric import chroma_noise
 from .results import BackgroundModel, SolverFailure
 from .solve_resolution import carry_backgrounds, downsample_window, PixelSample

@@ -10,15 +10,13 @@ here); :func:`judge` and :func:`learn` read each pixel's state once and do
 the same float32 arithmetic in the same order: the same model and verdicts,
 bit for bit (``test/test_depth_background.py``). Serial and ``nogil``: the
 depth callback runs beside the solve thread, whose kernels own the threads.
-Importing :mod:`dgmod_ros.core.kernels` first makes its process-wide numba
-settings (cache folder, threading layer) hold here too.
+numba's process-wide settings come with ``njit`` from
+:mod:`~dgmod_ros.core.numba_setup`.
 """
 
-from numba import njit
 import numpy as np
 
-# numba's cache folder and threading layer, set before the decorators below run.
-from . import kernels  # noqa: F401
+from ..numba_setup import njit, register_pass
 
 
 @njit(cache=True, nogil=True, inline='always')
@@ -101,11 +99,44 @@ def learn(depth, background, hits, near, far, far_frames, k, base, quadratic, sp
             far_frames[i] = 0
 
 
+_NOISE = (np.float32(4.0), np.float32(0.002), np.float32(0.005))    # k, base, quadratic
+
+
+def _state(rng, pixels):
+    """Return a random flat per-pixel state: background, hits, near, far, far_frames."""
+    background = rng.uniform(0.5, 4.0, pixels).astype(np.float32)
+    background[::7] = np.nan                                    # never seen
+    return [background, rng.integers(0, 12, pixels).astype(np.float32),
+            rng.integers(0, 6, pixels).astype(np.int32),
+            rng.uniform(0.5, 4.0, pixels).astype(np.float32),
+            rng.integers(0, 6, pixels).astype(np.int32)]
+
+
+def _depth(rng, background):
+    """Return readings near, at and behind ``background``, some missing."""
+    depth = background + rng.choice([-0.5, 0.0, 0.001, 0.5], background.size).astype(np.float32)
+    depth[::5] = np.nan
+    depth[::11] = rng.uniform(0.5, 4.0, depth[::11].size)
+    return depth.astype(np.float32)
+
+
+def _judge_examples():
+    rng = np.random.default_rng(0)
+    background, hits = _state(rng, 600)[:2]
+    return [(_depth(rng, background), background, hits, *_NOISE, np.float32(learn_frames),
+             np.zeros(600, np.uint8)) for learn_frames in (1.0, 10.0)]
+
+
+def _learn_examples():
+    rng = np.random.default_rng(1)
+    state = _state(rng, 600)
+    return [(_depth(rng, state[0]), *state, *_NOISE, np.float32(30.0), 3, 10, 5)]
+
+
+_PASSES = (register_pass(judge, _judge_examples), register_pass(learn, _learn_examples))
+
+
 def compile_kernel():
-    """Compile (or load from the cache) both passes on a tiny image."""
-    depth = np.ones(4, np.float32)
-    state = [np.ones(4, np.float32), np.ones(4, np.float32), np.zeros(4, np.int32),
-             np.ones(4, np.float32), np.zeros(4, np.int32)]
-    scalars = (np.float32(4.0), np.float32(0.002), np.float32(0.005))
-    judge(depth, state[0], state[1], *scalars, np.float32(1.0), np.zeros(4, np.uint8))
-    learn(depth, *state, *scalars, np.float32(300.0), 300, 10, 5)
+    """Compile (or load from the cache) both passes (the depth outputs' configure step)."""
+    for compiled_pass in _PASSES:
+        compiled_pass.warm_up()

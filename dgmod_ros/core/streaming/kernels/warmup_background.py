@@ -7,7 +7,7 @@ Before the first window solve (the first frames, and again after every
 scene-change restart) a frame's background is each entry's median over the
 buffered frames, and the noise level is read from the magnitudes of the
 differences of consecutive frames
-(:func:`~dgmod_ros.core.streaming.foreground.warmup_noise`). In numpy those
+(:func:`~dgmod_ros.core.streaming.noise_levels.warmup_noise`). In numpy those
 stack the buffered frames, take ``np.median`` along the short frame axis
 (a partition per entry) and ``np.diff`` of the stack with the frame: at
 640 x 480 x 3 that was 150-180 ms a frame, in the image callback, which lost
@@ -19,23 +19,18 @@ partitions), and the difference magnitudes are written without temporaries.
 Serial and ``nogil``: they run in the image callback beside the solve
 thread's kernels.
 
-Importing :mod:`dgmod_ros.core.kernels` first makes its process-wide numba
-settings (cache folder, ``threadsafe`` threading layer) hold here too.
+numba's process-wide settings come with ``njit`` from
+:mod:`~dgmod_ros.core.numba_setup`.
 """
 
-from numba import njit
 import numpy as np
 
-# numba's cache folder and threading layer, set before the decorators below run.
-from ..kernels import typed_frames
+from ...numba_setup import BLOCK_PIXELS, njit, register_pass, typed_frames
 
 
 #: Most frames whose per-entry median the compiled network takes (the
 #: default warm-up has at most 5; ``min_frames`` may ask for up to 300).
 NETWORK_FRAMES = 16
-# Entries a block of the median's sorting network holds per frame (one row of
-# scratch each, in cache).
-_BLOCK = 1024
 
 
 @njit(cache=True, nogil=True, inline='always')
@@ -53,10 +48,11 @@ def _entry_medians(frames, out):
     half = count // 2
     two = np.float32(2.0)
     nan = np.float32(np.nan)
-    values = np.empty((count, _BLOCK), dtype=np.float32)
+    # A block of entries per frame: one row of scratch each, in cache.
+    values = np.empty((count, BLOCK_PIXELS), dtype=np.float32)
     for channel in range(out.shape[0]):
-        for lo in range(0, out.shape[1], _BLOCK):
-            hi = min(out.shape[1], lo + _BLOCK)
+        for lo in range(0, out.shape[1], BLOCK_PIXELS):
+            hi = min(out.shape[1], lo + BLOCK_PIXELS)
             rows = values[:, :hi - lo]
             for j in range(count):
                 rows[j] = frames[j][channel, lo:hi]
@@ -126,8 +122,16 @@ def difference_magnitudes(frames):
     return out
 
 
-def compile_kernel():
-    """Compile (or load from the cache) both passes on a tiny input."""
-    frames = [np.full((3, 4), value, dtype=np.float32) for value in (0.0, 0.5, 0.25)]
-    entry_medians(frames)
-    difference_magnitudes(frames)
+def _examples():
+    """Return one to six frames of three channels over more than a block, some NaN entries."""
+    rng = np.random.default_rng(0)
+    examples = []
+    for count in range(1, 7):
+        frames = [rng.uniform(0, 1, (3, 2500)).astype(np.float32) for _ in range(count)]
+        frames[-1][:, ::97] = np.nan
+        examples.append((frames,))
+    return examples
+
+
+register_pass(entry_medians, _examples)
+register_pass(difference_magnitudes, _examples)

@@ -16,19 +16,16 @@ arithmetic as float32), so the answers are the same bit for bit; inputs of
 another type go to the reference. :func:`window_chroma` is the same
 chromaticity arithmetic over a whole window (the solve's chromaticity levels).
 
-Importing :mod:`dgmod_ros.core.kernels` first (through
-:mod:`~dgmod_ros.core.streaming.texture`) makes its process-wide numba
-settings (cache folder, ``threadsafe`` threading layer) hold here too.
+numba's process-wide settings come with ``njit`` from
+:mod:`~dgmod_ros.core.numba_setup`.
 """
 
 import math
 
-from numba import njit
 import numpy as np
 
-# texture imports kernels first: numba's cache folder and threading layer are
-# set before the decorators below run.
 from .texture import channel_bits, OFFSETS, RELATIVE_THRESHOLD, window_offsets
+from ...numba_setup import njit, register_pass
 
 # The reference's smallest squared background norm, as numpy's float32 comparison takes it.
 _DARK = np.float32(1e-6)
@@ -77,9 +74,14 @@ def _explain(frame, background, rows, cols, noise, chroma_level, candidates, k, 
         explained[i] = light
 
 
-def explained_pixels(test, columns, background, noise, k, shape, candidates, chroma_level):
+def explained_pixels(columns, background, noise, k, shape, candidates, chroma_level, use_chroma,
+                     use_texture, texture_bits):
     """
     Return :meth:`LightingTest.explains`'s answer (n,) bool, or None for the reference's inputs.
+
+    ``use_chroma``, ``use_texture`` and ``texture_bits`` are the test's parameters
+    (:class:`~dgmod_ros.core.streaming.photometric.LightingTest`), the
+    others :meth:`LightingTest.explains`'s.
 
     None unless the data are float32, ``k`` is a Python number and the
     chromaticity levels (if given) are float32: numpy computes in float64 otherwise.
@@ -98,8 +100,8 @@ def explained_pixels(test, columns, background, noise, k, shape, candidates, chr
     explained = np.empty(count, dtype=bool)
     _explain(np.ascontiguousarray(columns), np.ascontiguousarray(background), rows, cols,
              level, chroma, np.ascontiguousarray(candidates.reshape(-1)), np.float32(k),
-             np.float32(RELATIVE_THRESHOLD), bool(test.chroma), bool(test.texture),
-             int(test.texture_bits), OFFSETS, window_offsets(cols), explained)
+             np.float32(RELATIVE_THRESHOLD), bool(use_chroma), bool(use_texture),
+             int(texture_bits), OFFSETS, window_offsets(cols), explained)
     return explained
 
 
@@ -159,10 +161,27 @@ def window_chroma(data, residual):
     return chroma
 
 
-def compile_kernel():
-    """Compile (or load from the cache) the passes on a tiny input."""
-    window_chroma(np.ones((3, 4, 2), dtype=np.float32), np.zeros((3, 4, 2), dtype=np.float32))
-    from .photometric import LightingTest
-    frame = np.linspace(0.1, 0.9, 3 * 30, dtype=np.float32).reshape(3, 30)
-    LightingTest().explains(frame, frame * np.float32(0.9), 0.01, 6.0, (5, 6, 3),
-                            np.ones(30, dtype=bool))
+def _explain_examples():
+    """Return a frame with shadows, reflections and a body; each cue on and off."""
+    rng = np.random.default_rng(0)
+    rows, cols = 20, 30
+    background = rng.uniform(0.05, 0.95, (3, rows * cols)).astype(np.float32)
+    light = rng.choice([0.7, 1.0, 1.2], rows * cols).astype(np.float32)
+    frame = background * light
+    frame[:, 100:160] = rng.uniform(0, 1, (3, 60))                 # a body
+    noise = rng.uniform(0.005, 0.03, rows * cols).astype(np.float32)
+    candidates = rng.uniform(0, 1, rows * cols) < 0.6
+    chroma_level = rng.uniform(0.005, 0.05, rows * cols).astype(np.float32)
+    return [(frame, background, level, 6.0, (rows, cols, 3), candidates, chroma, *cues, 8)
+            for level, chroma in ((noise, chroma_level), (0.01, None))
+            for cues in ((True, True), (True, False), (False, True))]
+
+
+def _chroma_examples():
+    rng = np.random.default_rng(1)
+    data = rng.uniform(0, 1, (3, 700, 6)).astype(np.float32)
+    return [(data, rng.normal(0, 0.05, data.shape).astype(np.float32))]
+
+
+register_pass(explained_pixels, _explain_examples)
+register_pass(window_chroma, _chroma_examples)

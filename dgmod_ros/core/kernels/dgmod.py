@@ -15,7 +15,7 @@ arrays as the sweep needs (docs/solver.md, "Fused sweep").
 pass cannot wait for it.
 
 The pass runs on the **frames-major** transposes ``(m, n)`` of the matrices
-(:func:`frames_major`): a frame's pixels are one contiguous row, so each
+(:func:`~dgmod_ros.core.linalg.frames_major`): a frame's pixels are one contiguous row, so each
 step is a long unit-stride loop over a block's pixels that the compiler
 vectorises. In the ``n x m`` layout a row holds a pixel's ``m`` = 30 frames,
 too few for the vector loop to start, and the pass ran scalar
@@ -34,54 +34,13 @@ its own) and the Gram matrix is summed by register tiles: the sweep of the
 converged solve is bound by its arithmetic, not by memory (docs/solver.md,
 "Where a converged sweep's time goes").
 
-Import side effects, all process-wide and made before the first compiled call:
-
-- ``NUMBA_CACHE_DIR`` defaults to ``$XDG_CACHE_HOME/dgmod_ros/numba`` (else
-  ``~/.cache/dgmod_ros/numba``) when unset, so an installed package in a
-  read-only prefix still loads its compiled kernels from disk instead of
-  compiling them at every start; the kernels an install compiled (colcon
-  build) are copied there first where missing
-  (:mod:`~dgmod_ros.core.kernel_cache`);
-- ``numba.config.THREADING_LAYER = 'threadsafe'``: the node calls kernels from
-  its image callback and its solve thread at once, and numba's ``workqueue``
-  fallback stops the process when two threads enter it. ``threadsafe`` makes
-  numba take ``tbb`` or ``omp`` (libgomp, which comes with gcc) or fail loudly;
-- OpenBLAS runs on one thread (:func:`~dgmod_ros.core.runtime.limit_blas_threads`):
-  the kernels own the cores, and OpenBLAS threads spinning beside them made a
-  sweep several times slower (docs/solver.md, "Fused sweep").
+numba's process-wide settings (cache folder, threading layer, one OpenBLAS
+thread) come with ``njit`` from :mod:`~dgmod_ros.core.numba_setup`.
 """
 
-import os
-import sys
-import time
+import numpy as np
 
-from .kernel_cache import default_cache_dir, mark_ready, seed_cache
-
-if not os.environ.get('NUMBA_CACHE_DIR'):
-    os.environ['NUMBA_CACHE_DIR'] = default_cache_dir()
-seed_cache()
-# Also in the environment: numba re-reads its whole configuration from the
-# environment when that changed since its import (the line above does, when
-# another module imported numba first), which would reset an attribute set alone.
-os.environ.setdefault('NUMBA_THREADING_LAYER', 'threadsafe')
-
-import numba  # noqa: E402, I100 (the cache folder must be set before numba reads its config)
-from numba import njit, prange  # noqa: E402
-from numba.typed import List  # noqa: E402
-import numpy as np  # noqa: E402
-
-from .linalg import c_order  # noqa: E402
-from .runtime import limit_blas_threads  # noqa: E402
-
-if not numba.config.CACHE_DIR:      # numba was imported before this module
-    numba.config.CACHE_DIR = os.environ['NUMBA_CACHE_DIR']
-numba.config.THREADING_LAYER = 'threadsafe'
-limit_blas_threads(1)
-
-# Pixels per block of the threaded loops: long enough rows for the vector
-# loops, blocks few enough per thread to amortise the per-block scratch
-# rows, many enough (75 at 320 x 240) to balance two to eight threads.
-_BLOCK_PIXELS = 1024
+from ..numba_setup import BLOCK_PIXELS, FAST_MATH, njit, prange, register_pass
 
 
 @njit(cache=True, inline='always')
@@ -90,28 +49,23 @@ def _shrink(x, t):
     return x - min(max(x, -t), t)
 
 
-# Reassociation lets the compiler vectorise the sums of squares; no
-# 'nnan'/'ninf': the solver detects a non-finite iterate from those sums.
-# nogil: a pass takes milliseconds, and the node's image callback must not
-# wait for the solve thread's kernels.
-_FAST = {'reassoc', 'contract', 'nsz'}
-
-
-@njit(cache=True, inline='always', fastmath=_FAST)
+# nogil on the passes below: a pass takes milliseconds, and the node's image
+# callback must not wait for the solve thread's kernels.
+@njit(cache=True, inline='always', fastmath=FAST_MATH)
 def _add_product(weights, values, out):
     """``out += weights * values`` over three equally long rows."""
     for i in range(out.size):
         out[i] += weights[i] * values[i]
 
 
-@njit(cache=True, inline='always', fastmath=_FAST)
+@njit(cache=True, inline='always', fastmath=FAST_MATH)
 def _add_scaled(weight, values, out):
     """``out += weight * values`` over two equally long rows."""
     for i in range(out.size):
         out[i] += weight * values[i]
 
 
-@njit(cache=True, inline='always', fastmath=_FAST)
+@njit(cache=True, inline='always', fastmath=FAST_MATH)
 def _gradient_step(d, bg, u, lh, s, v, y2, spatial, temporal, l_new, coefficients):
     """Take one gradient L-step over a row segment into ``l_new`` (``Y1 = U - Lh``)."""
     g1, g2, c = coefficients[0], coefficients[1], coefficients[2]
@@ -122,7 +76,7 @@ def _gradient_step(d, bg, u, lh, s, v, y2, spatial, temporal, l_new, coefficient
         l_new[i] = bg[i] - step * grad
 
 
-@njit(cache=True, inline='always', fastmath=_FAST)
+@njit(cache=True, inline='always', fastmath=FAST_MATH)
 def _shrink_steps(d, bg, u, lh, s, v, y2, l_new, s_new, t_s, t_v, sums):
     """
     Take the S- and V-steps, ``Y2`` and the next ``Lh`` over a row segment; add up its sums.
@@ -166,12 +120,12 @@ def _shrink_steps(d, bg, u, lh, s, v, y2, l_new, s_new, t_s, t_v, sums):
 @njit(cache=True, nogil=True)
 def _block_u(rows, lo, hi, svt_left, svt_right):
     """Return ``svt_right (svt_left rows[:, lo:hi])`` (m x block)."""
-    # Two small matrix products: BLAS (one thread, kernels module docstring)
+    # Two small matrix products: BLAS (one thread, numba_setup's docstring)
     # runs them faster than a compiled loop here (docs/solver.md).
     return np.dot(svt_right, np.dot(svt_left, np.ascontiguousarray(rows[:, lo:hi])))
 
 
-@njit(cache=True, inline='always', fastmath=_FAST)
+@njit(cache=True, inline='always', fastmath=FAST_MATH)
 def _add_times(x, u0, u1, u2, u3, s0, s1, s2, s3):
     """Return ``(s0 + x u0, ..., s3 + x u3)``: one row of a Gram tile's update."""
     return s0 + x * u0, s1 + x * u1, s2 + x * u2, s3 + x * u3
@@ -186,7 +140,7 @@ def _add_tile(gram, a, c, count, sums):
                 gram[a + r, c + k] += sums[4 * r + k]
 
 
-@njit(cache=True, nogil=True, fastmath=_FAST)
+@njit(cache=True, nogil=True, fastmath=FAST_MATH)
 def _add_block_gram(rows, lo, hi, gram):
     """
     Add the upper triangle of ``rows[:, lo:hi] rows[:, lo:hi]^T`` to ``gram``, by 3 x 4 tiles.
@@ -221,7 +175,7 @@ def _add_block_gram(rows, lo, hi, gram):
             c += count
 
 
-@njit(parallel=True, cache=True, fastmath=_FAST, nogil=True)
+@njit(parallel=True, cache=True, fastmath=FAST_MATH, nogil=True)
 def primal_pass(data, L, U, Lh, S, V, Y2,
                 s_offsets, s_bands, t_offsets, t_bands, coefficients, l_given,
                 L_new, S_new, svt_left, svt_right, u_from_svt):
@@ -230,7 +184,7 @@ def primal_pass(data, L, U, Lh, S, V, Y2,
 
     Every matrix is **frames-major**, ``(m, n)``: the transpose of the
     solver's ``n x m`` window, one contiguous row of pixels per frame
-    (:func:`frames_major`). For each block of pixels and each frame ``j``:
+    (:func:`~dgmod_ros.core.linalg.frames_major`). For each block of pixels and each frame ``j``:
     the L-step (one gradient step into ``L_new``; with ``l_given`` the caller
     computed ``L_new`` in numpy), the S-step into ``S_new``, and in place the
     V-step, ``Y2 += D - L - S - V`` and the next SVT input ``Lh = L_new - Y1``.
@@ -258,12 +212,12 @@ def primal_pass(data, L, U, Lh, S, V, Y2,
     coefficients = coefficients.astype(np.float32)
     t_s = coefficients[6]
     t_v = coefficients[7]
-    n_blocks = (n + _BLOCK_PIXELS - 1) // _BLOCK_PIXELS
+    n_blocks = (n + BLOCK_PIXELS - 1) // BLOCK_PIXELS
     sums = np.zeros((n_blocks, 6), dtype=np.float64)
     grams = np.zeros((n_blocks, m, m), dtype=np.float64)
     for b in prange(n_blocks):
-        lo = b * _BLOCK_PIXELS
-        hi = min(n, lo + _BLOCK_PIXELS)
+        lo = b * BLOCK_PIXELS
+        hi = min(n, lo + BLOCK_PIXELS)
         spatial = np.empty(hi - lo, dtype=np.float32)
         temporal = np.empty(hi - lo, dtype=np.float32)
         block_sums = np.zeros(6, dtype=np.float64)
@@ -324,116 +278,57 @@ def frames_gram(rows):
     float64 across the blocks.
     """
     m, n = rows.shape
-    n_blocks = (n + _BLOCK_PIXELS - 1) // _BLOCK_PIXELS
+    n_blocks = (n + BLOCK_PIXELS - 1) // BLOCK_PIXELS
     grams = np.zeros((n_blocks, m, m), dtype=np.float64)
     for b in prange(n_blocks):
-        _add_block_gram(rows, b * _BLOCK_PIXELS, min(n, (b + 1) * _BLOCK_PIXELS), grams[b])
+        _add_block_gram(rows, b * BLOCK_PIXELS, min(n, (b + 1) * BLOCK_PIXELS), grams[b])
     return _symmetric_sum(grams)
 
 
-@njit(parallel=True, cache=True, fastmath=_FAST, nogil=True)
+@njit(parallel=True, cache=True, fastmath=FAST_MATH, nogil=True)
 def squared_gap(a, b):
     """Return ``||a - b||_F^2`` of two C-contiguous arrays in float64, threaded over blocks."""
     a = a.ravel()
     b = b.ravel()
     n = a.size
-    n_blocks = (n + _BLOCK_PIXELS - 1) // _BLOCK_PIXELS
+    n_blocks = (n + BLOCK_PIXELS - 1) // BLOCK_PIXELS
     sums = np.zeros(n_blocks, dtype=np.float64)
     for blk in prange(n_blocks):
         total = np.float32(0.0)
-        for i in range(blk * _BLOCK_PIXELS, min(n, (blk + 1) * _BLOCK_PIXELS)):
+        for i in range(blk * BLOCK_PIXELS, min(n, (blk + 1) * BLOCK_PIXELS)):
             gap = a[i] - b[i]
             total += gap * gap
         sums[blk] = total
     return sums.sum()
 
 
-def use_threads(count):
-    """
-    Let the kernels that the calling thread starts run on ``count`` threads (0: one per core).
-
-    numba's thread count is a setting of the thread that starts a parallel
-    kernel, so a solve thread can take fewer cores than the machine has and
-    leave one to the image callback, which starts serial kernels only (the
-    ``solve_threads`` parameter; docs/node.md has the measurements). A
-    kernel's result does not depend on it: its blocks of pixels are fixed.
-    Returns the count now in effect.
-    """
-    most = numba.config.NUMBA_NUM_THREADS
-    numba.set_num_threads(min(int(count), most) if count else most)
-    return numba.get_num_threads()
+def _window(rng, m, n):
+    """Return a random frames-major float32 array (m, n), C-ordered, as the solver's."""
+    return rng.uniform(-1.0, 1.0, (m, n)).astype(np.float32)
 
 
-def frames_major(matrix):
-    """
-    Return the ``(m, n)`` C-contiguous transpose of a float32 window ``matrix`` (n, m).
-
-    No copy when ``matrix`` already is such a transpose (an F-ordered
-    ``n x m`` array, as the fused solver's state is); else a blocked
-    transpose (:func:`~dgmod_ros.core.linalg.c_order`).
-    """
-    return c_order(np.asarray(matrix, dtype=np.float32).T)
-
-
-def typed_frames(frames):
-    """
-    Return a sequence of frames (each (C, n)) as a numba typed list of C-ordered float32 arrays.
-
-    A kernel that reads the frames where they are takes one compiled type
-    whatever their count (a window's buffered columns, without a stack);
-    each frame is copied only where it is not C-ordered float32 already.
-    """
-    return List([np.ascontiguousarray(frame, dtype=np.float32) for frame in frames])
+def _sweep_examples():
+    """Return the primal pass's arguments on small windows (both L-steps, both U sources)."""
+    rng = np.random.default_rng(0)
+    m, rows, cols, rank = 7, 30, 40, 2
+    n = rows * cols
+    s_offsets = np.array([-cols, -1, 0, 1, cols], dtype=np.int64)
+    t_offsets = np.array([-1, 0, 1], dtype=np.int64)
+    examples = []
+    for l_given, u_from_svt in ((False, False), (False, True), (True, True)):
+        iterates = [_window(rng, m, n) for _ in range(7)]
+        examples.append((*iterates, s_offsets, rng.uniform(0, 1, (5, n)).astype(np.float32),
+                         t_offsets, rng.uniform(0, 1, (3, m)).astype(np.float32),
+                         np.array([0.1, 0.2, 0.3, 1.0, 1.0, 0.4, 0.05, 0.5]), l_given,
+                         _window(rng, m, n), _window(rng, m, n), _window(rng, rank, m),
+                         _window(rng, m, rank), u_from_svt))
+    return examples
 
 
-def compile_all():
-    """
-    Compile (or load from the cache) every kernel by running it on a tiny window.
-
-    A cold compile takes tens of seconds on a small machine and holds the
-    GIL: ``colcon build`` runs this at install time, and a process that finds
-    the cache cold runs it in a child
-    (:class:`~dgmod_ros.core.kernel_cache.ChildCompile`), then here to
-    load. At the end the cache is marked ready for this install, with the
-    compile's seconds where anything was compiled.
-    """
-    start = time.monotonic()
-    _compile_every_kernel()
-    compiled = any(sum(dispatcher.stats.cache_misses.values())
-                   for dispatcher in _dispatchers())
-    mark_ready(time.monotonic() - start if compiled else None)
-
-
-def _dispatchers():
-    from numba.core.registry import CPUDispatcher
-    return [value for name, module in list(sys.modules.items())
-            if name.startswith(__package__.split('.')[0]) and module is not None
-            for value in vars(module).values() if isinstance(value, CPUDispatcher)]
-
-
-def _compile_every_kernel():
-    from .dgmod import DualGraphMOD
-    data = np.linspace(0.0, 1.0, 12 * 4, dtype=np.float32).reshape(12, 4)
-    DualGraphMOD(max_iter=1).fit(data, (3, 4))
-    DualGraphMOD(max_iter=1, l_step='exact').fit(data, (3, 4))
-    frames_gram(frames_major(data))     # the Gram matrix of a frames-major window
-    from .halving_kernel import compile_kernel as compile_halving
-    compile_halving()                                     # a frame to columns at scale 0.5
-    from .streaming.irls_kernel import compile_kernel     # the fast path's projection
-    compile_kernel()
-    from .streaming.mean_field_kernel import compile_kernel as compile_field
-    compile_field()                                       # the per-frame decision
-    from .streaming.blobs import compile_kernel as compile_blobs
-    compile_blobs()                                       # the ghost and still tests
-    from .streaming.lighting_kernel import compile_kernel as compile_lighting
-    compile_lighting()                                    # the lighting test
-    from .streaming.noise_kernel import compile_kernel as compile_noise
-    compile_noise()                                       # the solve's noise levels
-    from .streaming.carry_kernel import compile_kernel as compile_carry
-    compile_carry()                                       # the background refit
-    from .streaming.texture import compile_kernel as compile_texture
-    compile_texture()                                     # the moving-texture test
-    from .streaming.warmup_kernel import compile_kernel as compile_warmup
-    compile_warmup()                                      # the masks before the first solve
-    from .depth_kernel import compile_kernel as compile_depth
-    compile_depth()                                       # the depth background (use_depth)
+register_pass(primal_pass, _sweep_examples)
+register_pass(frames_gram,
+              lambda: [(_window(np.random.default_rng(seed), m, 2500),)
+                       for seed, m in enumerate((1, 2, 5, 7, 12))])
+register_pass(squared_gap,
+              lambda: [(_window(np.random.default_rng(1), 7, 2500),
+                        _window(np.random.default_rng(2), 7, 2500))])

@@ -12,15 +12,13 @@ at every solve and for every channel (docs/solver.md has the cost).
 contiguous row, and adds the frames in their order in float32, as the
 ``einsum`` did on the fused solver's window: there, the same sums bit for
 bit (``test/test_graphs.py``).
-Importing :mod:`dgmod_ros.core.kernels` first makes its process-wide numba
-settings hold here too; the pass is serial and ``nogil``.
+numba's process-wide settings come with ``njit`` from
+:mod:`~dgmod_ros.core.numba_setup`; the pass is serial and ``nogil``.
 """
 
-from numba import njit
 import numpy as np
 
-# numba's cache folder and threading layer, set before the decorator below runs.
-from . import kernels  # noqa: F401
+from ..numba_setup import njit, register_pass
 
 
 @njit(cache=True, nogil=True)
@@ -58,3 +56,8 @@ def neighbour_square_sums(frames):
     down = np.empty((max(rows - 1, 0), cols), dtype=np.float32)
     _neighbour_square_sums(frames, right, down)
     return right, down
+
+
+register_pass(neighbour_square_sums,
+              lambda: [(np.random.default_rng(0).uniform(0, 1, (m, 20, 30)).astype(np.float32),)
+                       for m in (1, 7)])

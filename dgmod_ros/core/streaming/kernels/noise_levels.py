@@ -3,20 +3,19 @@
 """
 The observed entries of a window's residual, ready for their per-pixel median, in one pass.
 
-:func:`~dgmod_ros.core.streaming.foreground.observed_median` sorts each
+:func:`~dgmod_ros.core.streaming.noise_levels.observed_median` sorts each
 pixel's row with the unobserved entries set to infinity, so that they sort
 last, and counts the observed ones. In numpy those are ``np.where`` and
 ``np.count_nonzero`` along the rows, two passes that together cost more
 than the sort itself (docs/solver.md, "Where a converged sweep's time goes").
 :func:`observed_rows` writes the filled rows and the counts in one pass,
-with the same values. It is serial and ``nogil``.
+with the same values. It is serial and ``nogil``; numba's process-wide
+settings come with ``njit`` from :mod:`~dgmod_ros.core.numba_setup`.
 """
 
-from numba import njit
 import numpy as np
 
-# numba's cache folder and threading layer, set before the decorator below runs.
-from .. import kernels  # noqa: F401
+from ...numba_setup import njit, register_pass
 
 
 @njit(cache=True, nogil=True)
@@ -48,6 +47,10 @@ def observed_rows(magnitude, observed):
     return filled, count
 
 
-def compile_kernel():
-    """Compile (or load from the cache) the pass on a tiny input."""
-    observed_rows(np.ones((2, 3), dtype=np.float32), np.ones((2, 3), dtype=np.bool_))
+def _examples():
+    rng = np.random.default_rng(0)
+    return [(rng.uniform(0, 1, (500, m)).astype(np.float32), rng.uniform(0, 1, (500, m)) < 0.7)
+            for m in (1, 6, 30)]
+
+
+register_pass(observed_rows, _examples)

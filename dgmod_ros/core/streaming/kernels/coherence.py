@@ -28,15 +28,13 @@ operation for operation, in float32:
   the arithmetic would give exactly -1 there (the box sum is then exactly
   ``-(2 r + 1)**2``), and most of a frame is such rows.
 
-Importing :mod:`dgmod_ros.core.kernels` first makes its process-wide numba
-settings (cache folder, ``threadsafe`` threading layer) hold here too.
+numba's process-wide settings come with ``njit`` from
+:mod:`~dgmod_ros.core.numba_setup`.
 """
 
-from numba import njit
 import numpy as np
 
-# numba's cache folder and threading layer, set before the decorators below run.
-from .. import kernels  # noqa: F401
+from ...numba_setup import njit, register_pass
 
 #: Halved log-odds from which numpy's float32 tanh is exactly +-1 (it is from 10.00003).
 SATURATED = np.float32(10.5)
@@ -253,7 +251,17 @@ def mean_field_spins(distance, noise, k, beta, rows, cols, sweeps, radius, z_cap
     return spin
 
 
-def compile_kernel():
-    """Compile (or load from the cache) the field's kernels on a tiny input."""
-    mean_field_spins(np.linspace(0, 1, 12, dtype=np.float32), 0.1, 6.0, 2.0, 3, 4, 1, 2,
-                     3.0, 50.0)
+def _examples():
+    """Return fields of a frame with blobs: one noise level and k for all, or each pixel's own."""
+    rng = np.random.default_rng(0)
+    rows, cols = 30, 40
+    z = np.abs(rng.normal(0, 2.5, (rows, cols))).astype(np.float32)
+    z[5:15, 8:20] += 8.0
+    noise = rng.uniform(0.005, 0.05, rows * cols).astype(np.float32)
+    distance = (z.ravel() * noise).astype(np.float32)
+    k = np.where(rng.uniform(0, 1, rows * cols) < 0.2, 4.5, 6.0).astype(np.float32)
+    return [(distance, 0.02, 6.0, 2.0, rows, cols, 5, 2, 3.0, 50.0),
+            (distance, noise, k, 1.3, rows, cols, 5, 2, 3.0, 50.0)]
+
+
+register_pass(mean_field_spins, _examples)

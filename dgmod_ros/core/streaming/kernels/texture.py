@@ -17,7 +17,11 @@ Each colour channel gets its own pattern; the distances add up over the
 channels (0 to 16 C bits). The distance is computed only at the pixels asked
 for (the decision's candidates), which keeps its cost proportional to the
 foreground, by a serial numba kernel (no threads: it runs in the image
-callback beside the solve thread's parallel kernels).
+callback beside the solve thread's parallel kernels). The decision's
+moving-texture rule (:mod:`~dgmod_ros.core.streaming.decision`) and the
+lighting test (:mod:`~dgmod_ros.core.streaming.photometric`) read it;
+numba's process-wide settings come with ``njit`` from
+:mod:`~dgmod_ros.core.numba_setup`.
 
 References
 ----------
@@ -28,10 +32,9 @@ local binary similarity patterns", WACV 2014 (LOBSTER).
 
 """
 
-from numba import njit
 import numpy as np
 
-from .. import kernels  # noqa: F401 (sets numba's cache folder before the first compile)
+from ...numba_setup import njit, register_pass
 
 #: The 16 neighbours (row, col offsets) of the 5 x 5 double-cross pattern.
 PATTERN = ((-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1),
@@ -119,7 +122,14 @@ def descriptor_distance(frame, background, threshold, pixels):
     return out
 
 
-def compile_kernel():
-    """Compile (or load from the cache) the distance's kernel on a tiny input."""
-    frame = np.zeros((3, 5, 5), dtype=np.float32)
-    descriptor_distance(frame, frame, np.zeros((3, 1), dtype=np.float32), np.array([12]))
+def _examples():
+    """Return a frame and its background with some pixels inside and on the border."""
+    rng = np.random.default_rng(0)
+    background = rng.uniform(0, 1, (3, 20, 30)).astype(np.float32)
+    frame = background * rng.uniform(0.6, 1.4, background.shape).astype(np.float32)
+    pixels = np.array([0, 1, 29, 31, 45, 300, 599, 570, 333])
+    threshold = rng.uniform(0.01, 0.2, (3, pixels.size)).astype(np.float32)
+    return [(frame, background, threshold, pixels)]
+
+
+register_pass(descriptor_distance, _examples)

@@ -13,15 +13,14 @@ clipped as :func:`~dgmod_ros.core.preprocess.to_float_channels` does, and
 the area ``(((a + b) + c) + d) * 0.25`` in the order of OpenCV's
 integer-ratio area resize, so the columns are the same bit for bit
 (``test/test_per_frame_kernels.py``).
-Importing :mod:`dgmod_ros.core.kernels` first makes its process-wide numba
-settings hold here too; the pass is serial and ``nogil`` (the image callback's).
+numba's process-wide settings come with ``njit`` from
+:mod:`~dgmod_ros.core.numba_setup`; the pass is serial and ``nogil``
+(the image callback's).
 """
 
-from numba import njit
 import numpy as np
 
-# numba's cache folder and threading layer, set before the decorator below runs.
-from . import kernels  # noqa: F401
+from ..numba_setup import njit, register_pass
 
 
 @njit(cache=True, nogil=True)
@@ -60,15 +59,22 @@ def half_columns(image, scale, reverse):
     return out
 
 
-def compile_kernel():
+def _examples():
     """
-    Compile (or load from the cache) the pass for 8- and 16-bit frames.
+    Return frames of 8 and 16 bits, writeable and read-only, in both channel orders.
 
     Writeable and read-only frames both (a frame viewing a message's bytes
     is read-only), since numba compiles each apart.
     """
+    rng = np.random.default_rng(0)
+    examples = []
     for dtype in (np.uint8, np.uint16):
         for writeable in (True, False):
-            frame = np.zeros((2, 2, 3), dtype=dtype)
+            top = np.iinfo(dtype).max
+            frame = rng.integers(0, top, (24, 32, 3), endpoint=True).astype(dtype)
             frame.setflags(write=writeable)
-            half_columns(frame, 1.0 / np.iinfo(dtype).max, False)
+            examples.extend((frame, 1.0 / top, reverse) for reverse in (False, True))
+    return examples
+
+
+register_pass(half_columns, _examples)

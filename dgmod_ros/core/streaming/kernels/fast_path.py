@@ -3,26 +3,23 @@
 """
 The compiled pass of the fast path's l1 projection (one IRLS sweep's normal equations).
 
-Importing :mod:`dgmod_ros.core.kernels` first makes its process-wide numba
-settings (cache folder, ``threadsafe`` threading layer) hold here too. The
-pass is serial and ``nogil``: it runs in the image callback while the solve
+numba's process-wide settings come with ``njit`` from
+:mod:`~dgmod_ros.core.numba_setup`.
+The pass is serial and ``nogil``: it runs in the image callback while the solve
 thread's kernels own the cores, and a frame's few hundred thousand entries
 are less work than starting threads.
 """
 
-from numba import njit
 import numpy as np
 
-# numba's cache folder and threading layer, set before the decorators below run.
-from .. import kernels  # noqa: F401
+from ...numba_setup import FAST_MATH, njit, register_pass
 
 
-# Reassociation lets the compiler vectorise the sums over pixels; no 'nnan':
-# a non-finite frame must stay visible.
-_FAST = {'reassoc', 'contract', 'nsz', 'arcp'}
+# The passes' flags and reciprocals (the weights are ones over the residuals).
+_FAST_ARCP = FAST_MATH | {'arcp'}
 
 
-@njit(cache=True, nogil=True, fastmath=_FAST)
+@njit(cache=True, nogil=True, fastmath=_FAST_ARCP)
 def _rank2_equations(basis, columns, coef, floor, gram, rhs):
     # The default basis_rank spelled out: scalar sums the compiler vectorises.
     for c in range(basis.shape[0]):
@@ -48,7 +45,7 @@ def _rank2_equations(basis, columns, coef, floor, gram, rhs):
         rhs[c, 1] = r1
 
 
-@njit(cache=True, nogil=True, fastmath=_FAST)
+@njit(cache=True, nogil=True, fastmath=_FAST_ARCP)
 def _rank1_equations(basis, columns, coef, floor, gram, rhs):
     # A still scene's background has rank 1.
     for c in range(basis.shape[0]):
@@ -64,7 +61,7 @@ def _rank1_equations(basis, columns, coef, floor, gram, rhs):
         rhs[c, 0] = r0
 
 
-@njit(cache=True, nogil=True, fastmath=_FAST)
+@njit(cache=True, nogil=True, fastmath=_FAST_ARCP)
 def _any_rank_equations(basis, columns, coef, floor, gram, rhs):
     channels, n, rank = basis.shape
     for c in range(channels):
@@ -114,9 +111,16 @@ def weighted_normal_equations(basis, columns, coef, floor, gram, rhs):
     kernel(basis, columns, coef, floor, gram, rhs)
 
 
-def compile_kernel():
-    """Compile (or load from the cache) both passes on a tiny input."""
+def _examples():
+    """Return a frame's fit at ranks 1 (a still scene), 2 (the default) and 3 (any other)."""
+    rng = np.random.default_rng(0)
+    examples = []
     for rank in (1, 2, 3):
-        weighted_normal_equations(np.ones((1, 4, rank), dtype=np.float32),
-                                  np.ones((1, 4), dtype=np.float32), np.zeros((1, rank)),
-                                  1e-3, np.empty((1, rank, rank)), np.empty((1, rank)))
+        basis = rng.normal(0, 0.05, (3, 400, rank)).astype(np.float32)
+        columns = rng.uniform(0, 1, (3, 400)).astype(np.float32)
+        examples.append((basis, columns, rng.normal(0, 1, (3, rank)), 1e-3,
+                         np.empty((3, rank, rank)), np.empty((3, rank))))
+    return examples
+
+
+register_pass(weighted_normal_equations, _examples)

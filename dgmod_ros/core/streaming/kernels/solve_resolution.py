@@ -13,24 +13,19 @@ sums read the window and the weights several times and cost about three
 times as much. The frames are read where they are, a snapshot's buffered
 columns included (:meth:`~dgmod_ros.core.streaming.results.WindowSnapshot.frames`),
 instead of a 640 x 480 window stacked only for this pass.
-Importing :mod:`dgmod_ros.core.kernels` first makes its process-wide numba
-settings (cache folder, ``threadsafe`` threading layer) hold here too.
+numba's process-wide settings come with ``njit`` from
+:mod:`~dgmod_ros.core.numba_setup`.
 """
 
-from numba import njit, prange
 import numpy as np
 
-# numba's cache folder and threading layer, set before the decorators below run;
-# and the solver's pixel blocks.
-from ..kernels import _BLOCK_PIXELS, typed_frames
-
-_FAST = {'reassoc', 'contract', 'nsz'}
+from ...numba_setup import BLOCK_PIXELS, FAST_MATH, njit, prange, register_pass, typed_frames
 
 
-@njit(parallel=True, cache=True, nogil=True, fastmath=_FAST)
+@njit(parallel=True, cache=True, nogil=True, fastmath=FAST_MATH)
 def _normal_equations(frames, held_out, temporal, ranks, gram, rhs):
     m, (channels, n) = len(frames), frames[0].shape
-    block = _BLOCK_PIXELS
+    block = BLOCK_PIXELS
     for b in prange((n + block - 1) // block):
         lo = b * block
         hi = min(n, lo + block)
@@ -97,7 +92,14 @@ def normal_equations(frames, held_out, temporals):
     return systems
 
 
-def compile_kernel():
-    """Compile (or load from the cache) the pass on a tiny input."""
-    normal_equations(np.ones((4, 3, 5), dtype=np.float32), np.zeros((4, 5), dtype=np.float32),
-                     [np.ones((4, 2), dtype=np.float32)] * 3)
+def _examples():
+    """Return windows of a few frames, channels of ranks 2, 1 and 3, some entries held out."""
+    rng = np.random.default_rng(0)
+    m, n = 6, 2500
+    frames = rng.uniform(0, 1, (m, 3, n)).astype(np.float32)
+    held_out = (rng.uniform(0, 1, (m, n)) < 0.2).astype(np.float32)
+    temporals = [rng.normal(0, 1, (m, rank)).astype(np.float32) for rank in (2, 1, 3)]
+    return [(frames, held_out, temporals), (list(frames), held_out, temporals[:1] * 3)]
+
+
+register_pass(normal_equations, _examples)

@@ -1,0 +1,143 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""
+Each pixel's own noise level, read from a window solve (and before the first one).
+
+One threshold for the whole frame treats a flickering monitor and a flat
+wall alike: the decision (:mod:`~dgmod_ros.core.streaming.decision`) gives
+every pixel ``k`` times its own noise level ``sigma_p``, read from the last
+window solve: the median of ``|D - L|`` (largest over the
+colour channels) over the window's columns in which the pixel was observed
+(its frame's mask called it background, see
+:mod:`~dgmod_ros.core.streaming.background_memory`), times 1.4826 (the
+standard deviation for Gaussian noise). Leaving out the columns the masks
+called foreground keeps a passing person from raising the level, which a
+median alone does only while the person is in fewer than half of the
+columns: a young window of a few consecutive frames often has a walker in
+most of them. A pixel observed in fewer than half of the columns takes the
+median over all of them instead: the masks, not the pixel, are in doubt
+there (leaves that the first masks took for foreground keep their level).
+No pixel is taken as quieter than the frame's typical pixel (the median of
+``sigma_p`` over the frame): only noisy places get a higher threshold, and a
+pixel seen fewer than :data:`MIN_OBSERVED` times gets the typical level. The
+levels are smoothed by the median of a 5 x 5 neighbourhood, which shares the
+noise of a surface (leaves, a screen) without spreading a region's level
+over its border (a box filter carried a walker's raised level 2 pixels out,
+into the pixels where the walker comes next). Before the first solve,
+one level for all pixels is read from the differences of consecutive
+frames (:func:`warmup_noise`).
+"""
+
+import math
+
+import cv2
+import numpy as np
+
+from .kernels.warmup_background import difference_magnitudes
+from ..linalg import row_median
+from ..masks import robust_sigma
+
+#: Observations a pixel needs for its own noise level.
+MIN_OBSERVED = 3
+# Gaussian consistency factor of the median absolute value.
+_MAD_TO_SIGMA = 1.4826
+# Side of the median filter that smooths the noise levels (3 or 5: float32 input).
+_NOISE_SMOOTHING = 5
+# Smallest noise level: one grey level of 8-bit data.
+_QUANTUM = 1.0 / 255.0
+
+
+def observed_median(magnitude, observed=None):
+    """
+    Return each row's median (n,) over its observed entries, and their count (n,).
+
+    With ``observed`` None, numpy's median of the whole row (the mean of the
+    middle two for an even count), taken from a sort
+    (:func:`~dgmod_ros.core.linalg.row_median`): ``np.median`` along the
+    short rows of an (n, m) array is about 4x slower. Otherwise the lower
+    median of the observed entries. The magnitudes are float32 and finite (a
+    solve's residual), so sorting and ``np.median`` agree.
+    """
+    if observed is None:
+        return row_median(magnitude), np.full(magnitude.shape[0], magnitude.shape[1])
+    from .kernels.noise_levels import observed_rows     # numba: loaded on first use
+    filled, count = observed_rows(magnitude, observed)
+    ordered = np.sort(filled, axis=1)           # unobserved entries (inf) last
+    return ordered[np.arange(ordered.shape[0]), np.maximum(count - 1, 0) // 2], count
+
+
+def pixel_noise(residual, shape, observed=None, uniform=False, sample=None):
+    """
+    Return each pixel's noise level ``sigma_p`` (n,) float32 from a window's residual.
+
+    Parameters
+    ----------
+    residual : ndarray (C, n, m)
+        ``D - L`` of the window; with ``sample``, of its sampled pixels only (C, k, m).
+    shape : tuple (rows, cols, C)
+        Processing shape.
+    observed : ndarray (n, m) bool or None
+        Entries counted in the level: the frame's own pixel, where its mask
+        called it background (with ``sample``: (k, m)); None: all.
+    uniform : bool
+        Give every pixel the typical level (the ablation of the per-pixel rule).
+    sample : PixelSample or None
+        The levels are read at ``sample``'s pixels, a coarser grid of the
+        frame (:class:`~dgmod_ros.core.streaming.solve_resolution.PixelSample`),
+        and upsampled to ``shape`` before the smoothing; None: at every pixel.
+
+    """
+    return magnitude_noise(np.abs(residual).max(axis=0), shape, observed, uniform, sample)
+
+
+def magnitude_noise(magnitude, shape, observed=None, uniform=False, sample=None):
+    """
+    Return :func:`pixel_noise` from the magnitude of the residual (n, m).
+
+    ``magnitude`` is ``|D - L|``, largest over the channels, for a caller
+    that has it already, or a non-negative statistic of its own (the
+    chromaticity distance); the other parameters are :func:`pixel_noise`'s.
+    """
+    rows, cols = shape[:2]
+    median, count = observed_median(magnitude, observed)
+    if observed is not None:
+        doubtful = count < magnitude.shape[1] / 2
+        if doubtful.any():
+            median[doubtful] = observed_median(magnitude[doubtful])[0]
+            count[doubtful] = magnitude.shape[1]
+    sigma = _MAD_TO_SIGMA * median
+    seen = count >= MIN_OBSERVED
+    typical = float(np.median(sigma[seen])) if np.any(seen) else robust_sigma(magnitude)
+    typical = max(typical, _QUANTUM)
+    if uniform:
+        return np.full(rows * cols, typical, dtype=np.float32)
+    sigma = np.where(seen, np.maximum(sigma, typical), typical).astype(np.float32)
+    if sample is not None:
+        # Upsampled unsmoothed, so that the smoothing below spans the same
+        # neighbourhood of the frame as at every pixel.
+        sigma = sample.upsample(sigma)
+    smooth = cv2.medianBlur(sigma.reshape(rows, cols), _NOISE_SMOOTHING)
+    return smooth.ravel()
+
+
+def warmup_noise(frames):
+    """
+    Return one noise level for every pixel before the first solve, from frame differences.
+
+    ``frames`` are the buffered frames and the frame itself, each (C, n),
+    oldest first. The level is read like :func:`pixel_noise` reads the
+    residual: 1.4826 times the median magnitude (largest over the channels)
+    of the differences of consecutive frames, over all pixels, divided by
+    sqrt(2) (a difference holds the noise of two frames). The magnitudes are
+    not centred on their median first: their spread around their median
+    says how alike they are, not how large, and a frame-wide change of a few
+    grey levels (an exposure step between the first frames) then gave a
+    level near 0 and a mask full of specks. A Python float, as every level
+    the decision takes as one number: the decision then computes in
+    float32, as with each pixel's own levels.
+    """
+    if len(frames) < 2:
+        return _QUANTUM
+    differences = difference_magnitudes(frames)
+    median = float(np.median(differences, overwrite_input=True))    # a temporary
+    return max(_MAD_TO_SIGMA * median / math.sqrt(2.0), _QUANTUM)
