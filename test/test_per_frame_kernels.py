@@ -11,9 +11,9 @@ from dgmod_ros.core.streaming.held_foreground import still_blob_pixels
 from dgmod_ros.core.streaming.kernels import coherence as mean_field_kernel
 from dgmod_ros.core.streaming.kernels import photometric as lighting_kernel
 from dgmod_ros.core.streaming.kernels import warmup_background as warmup_kernel
-from dgmod_ros.core.streaming.kernels.photometric import explained_pixels
+from dgmod_ros.core.streaming.kernels.photometric import distortion, explained_pixels
 from dgmod_ros.core.streaming.noise_levels import observed_median, warmup_noise
-from dgmod_ros.core.streaming.photometric import distortion, LightingTest
+from dgmod_ros.core.streaming.photometric import LightingTest
 from dgmod_ros.core.streaming.upsizing import to_input_size
 import numpy as np
 import pytest

@@ -4,8 +4,9 @@
 
 from dgmod_ros.core.streaming import SlidingWindowDetector
 from dgmod_ros.core.streaming.decision import adaptive_mask
+from dgmod_ros.core.streaming.kernels.photometric import distortion
 from dgmod_ros.core.streaming.kernels.texture import descriptor_distance, PATTERN
-from dgmod_ros.core.streaming.photometric import distortion, LightingTest
+from dgmod_ros.core.streaming.photometric import LightingTest
 import numpy as np
 import pytest
 

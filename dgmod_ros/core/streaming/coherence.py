@@ -33,8 +33,10 @@ References
 
 """
 
-import cv2
 import numpy as np
+
+from .kernels.coherence import mean_field_spins, mean_field_spins_reference
+from ..numba_setup import reference_unless
 
 #: Mean-field sweeps; the masks change little after 5 (``docs/results.md``).
 SWEEPS = 5
@@ -50,9 +52,9 @@ def mean_field_mask(distance, noise, k, beta, shape, sweeps=SWEEPS, radius=RADIU
     """
     Return the foreground (rows, cols) uint8 0/255 of the Potts field over the k-sigma rule.
 
-    The sweeps of :func:`mean_field_mask_reference`, compiled
-    (:mod:`~dgmod_ros.core.streaming.kernels.coherence`): the same masks bit
-    for bit, falling back to the reference where the kernel cannot promise it.
+    The sweeps compiled (:mod:`~dgmod_ros.core.streaming.kernels.coherence`),
+    the numpy reference's spins bit for bit, the reference itself where the
+    pass cannot promise them.
 
     Parameters
     ----------
@@ -73,27 +75,15 @@ def mean_field_mask(distance, noise, k, beta, shape, sweeps=SWEEPS, radius=RADIU
         Neighbourhood radius ``r`` (square of side ``2 r + 1``).
 
     """
-    from .kernels.coherence import mean_field_spins     # numba: loaded on first use
     rows, cols = shape[:2]
-    spin = mean_field_spins(distance, noise, k, beta, rows, cols, sweeps, radius, _Z_CAP,
-                            _LOGIT_CAP)
-    if spin is None:
-        return mean_field_mask_reference(distance, noise, k, beta, shape, sweeps, radius)
+    spin = reference_unless(mean_field_spins, mean_field_spins_reference, distance, noise, k,
+                            beta, rows, cols, sweeps, radius, _Z_CAP, _LOGIT_CAP)
     return np.where(spin > 0, np.uint8(255), np.uint8(0))
 
 
 def mean_field_mask_reference(distance, noise, k, beta, shape, sweeps=SWEEPS, radius=RADIUS):
     """Return :func:`mean_field_mask` computed in numpy and OpenCV (the tests' reference)."""
     rows, cols = shape[:2]
-    k = np.reshape(np.asarray(k, dtype=np.float32), -1)
-    z = np.minimum(np.reshape(distance, -1) / noise, _Z_CAP * k)
-    unary = ((z * z - k * k) / 2).astype(np.float32).reshape(rows, cols)
-    side = 2 * int(radius) + 1
-    spin = np.where(unary > 0, np.float32(1), np.float32(-1))      # the plain rule
-    for _ in range(int(sweeps)):
-        # Sum of the neighbours' expected spins (the pixel itself excluded).
-        neighbours = cv2.boxFilter(spin, -1, (side, side), normalize=False,
-                                   borderType=cv2.BORDER_REPLICATE) - spin
-        logit = np.clip(unary + beta * neighbours, -_LOGIT_CAP, _LOGIT_CAP)
-        spin = np.tanh(logit / 2)                  # 2 q - 1 with q = sigmoid(logit)
+    spin = mean_field_spins_reference(distance, noise, k, beta, rows, cols, sweeps, radius,
+                                      _Z_CAP, _LOGIT_CAP)
     return np.where(spin > 0, np.uint8(255), np.uint8(0))

@@ -11,6 +11,8 @@ frames is the background.
 
 import numpy as np
 
+from .kernels.fast_path import (irls_weights, weighted_normal_equations,
+                                weighted_normal_equations_reference)
 from ..linalg import thin_svd
 
 # IRLS sweeps of the l1 projection; residual changes are below 1e-3 after
@@ -50,16 +52,29 @@ def sampled_basis(basis, fit_pixels=None):
     return basis if step == 1 else np.ascontiguousarray(basis[:, ::step])
 
 
+def irls(coef, normal_equations, solve):
+    """
+    Return the coefficients after the IRLS sweeps from ``coef``: the one loop of every l1 fit here.
+
+    Each sweep forms the normal equations weighted by the current residual
+    (``normal_equations(coef)``, weights
+    :func:`~dgmod_ros.core.streaming.kernels.fast_path.irls_weights`) and
+    solves them (``solve(gram, rhs)``).
+    """
+    for _ in range(_IRLS_SWEEPS):
+        coef = solve(*normal_equations(coef))
+    return coef
+
+
 def robust_projection(basis, columns, fit_pixels=None, fit_basis=None):
     """
     l1-fit each channel's column onto its basis by IRLS; return the fitted columns.
 
-    The same iterations as :func:`robust_projection_reference`, with each
-    sweep's weighted normal equations formed in one compiled pass
-    (:mod:`~dgmod_ros.core.streaming.kernels.fast_path`, float64 sums) instead of
-    five numpy passes. The sweeps start from the least-squares coefficients
-    of every pixel and weigh every ``fit_step``-th pixel only; the returned
-    projection is of every pixel.
+    Each sweep's weighted normal equations are formed in one compiled pass
+    (:func:`~dgmod_ros.core.streaming.kernels.fast_path.weighted_normal_equations`,
+    float64 sums) instead of five numpy passes. The sweeps start from the
+    least-squares coefficients of every pixel and weigh every
+    ``fit_step``-th pixel only; the returned projection is of every pixel.
 
     Parameters
     ----------
@@ -73,38 +88,37 @@ def robust_projection(basis, columns, fit_pixels=None, fit_basis=None):
         ``sampled_basis(basis, fit_pixels)`` where the caller keeps it; None forms it.
 
     """
-    from .kernels.fast_path import weighted_normal_equations    # numba: loaded on first use
+    return _robust_projection(basis, columns, fit_pixels, fit_basis, weighted_normal_equations)
+
+
+def robust_projection_reference(basis, columns, fit_pixels=None):
+    """Return :func:`robust_projection` with numpy's normal equations (the tests' reference)."""
+    return _robust_projection(basis, columns, fit_pixels, None,
+                              weighted_normal_equations_reference)
+
+
+def _robust_projection(basis, columns, fit_pixels, fit_basis, equations):
     basis = np.ascontiguousarray(basis, dtype=np.float32)
     columns = np.ascontiguousarray(columns, dtype=np.float32)
     channels, n, rank = basis.shape
-    coef = np.matmul(columns[:, None, :], basis)[:, 0, :].astype(np.float64)
     gram = np.empty((channels, rank, rank))
     rhs = np.empty((channels, rank))
     step = fit_step(n, fit_pixels)
     if fit_basis is None:
         fit_basis = sampled_basis(basis, fit_pixels)
     fit_columns = columns if step == 1 else np.ascontiguousarray(columns[:, ::step])
-    for _ in range(_IRLS_SWEEPS):
-        weighted_normal_equations(fit_basis, fit_columns, coef, _IRLS_FLOOR, gram, rhs)
-        for channel in range(channels):
-            coef[channel] = np.linalg.lstsq(gram[channel], rhs[channel], rcond=None)[0]
+
+    def normal_equations(coef):
+        equations(fit_basis, fit_columns, coef, _IRLS_FLOOR, gram, rhs)
+        return gram, rhs
+
+    def solve(gram, rhs):
+        return np.stack([np.linalg.lstsq(gram[channel], rhs[channel], rcond=None)[0]
+                         for channel in range(channels)])
+
+    coef = np.matmul(columns[:, None, :], basis)[:, 0, :].astype(np.float64)
+    coef = irls(coef, normal_equations, solve)
     return np.matmul(basis, coef.astype(np.float32)[:, :, None])[:, :, 0]
-
-
-def robust_projection_reference(basis, columns, fit_pixels=None):
-    """Return :func:`robust_projection` computed in numpy (what the tests compare with)."""
-    fitted = np.empty_like(columns)
-    step = fit_step(columns.shape[1], fit_pixels)
-    for channel in range(columns.shape[0]):
-        b, d = basis[channel], columns[channel]
-        coef = b.T @ d
-        b_fit, d_fit = b[::step], d[::step]
-        for _ in range(_IRLS_SWEEPS):
-            weights = 1.0 / np.maximum(np.abs(d_fit - b_fit @ coef), _IRLS_FLOOR)
-            weighted = b_fit * weights[:, None]
-            coef = np.linalg.lstsq(weighted.T @ b_fit, weighted.T @ d_fit, rcond=None)[0]
-        fitted[channel] = b @ coef
-    return fitted
 
 
 def projection_residual(basis, data, robust=True):
@@ -136,10 +150,14 @@ def projection_residual(basis, data, robust=True):
             b_fit, d_fit = b[::step], d[::step]
             products = (b_fit[:, :, None] * b_fit[:, None, :]).reshape(b_fit.shape[0],
                                                                        rank * rank)
-            for _ in range(_IRLS_SWEEPS):
-                weights = 1.0 / np.maximum(np.abs(d_fit - b_fit @ coef), _IRLS_FLOOR)
-                gram = (products.T @ weights).T.reshape(-1, rank, rank)      # (m, r, r)
-                right = (b_fit.T @ (weights * d_fit)).T[..., None]          # (m, r, 1)
-                coef = np.linalg.solve(gram, right)[..., 0].T
+
+            def normal_equations(coef):
+                # Every column's system at once: (m, r, r) and (m, r, 1).
+                weights = irls_weights(d_fit - b_fit @ coef, _IRLS_FLOOR)
+                return ((products.T @ weights).T.reshape(-1, rank, rank),
+                        (b_fit.T @ (weights * d_fit)).T[..., None])
+
+            coef = irls(coef, normal_equations,
+                        lambda gram, right: np.linalg.solve(gram, right)[..., 0].T)
         residual[channel] = d - b @ coef
     return residual

@@ -15,7 +15,8 @@ light plausibly does. Horprasert et al. split a pixel's colour difference
 - chromaticity distortion ``c = |I - alpha E|``, in the units of the data.
 
 A candidate pixel (its distance above ``k`` noise levels) is a change of
-light when all the enabled cues agree:
+light when all the enabled cues agree
+(:func:`~dgmod_ros.core.streaming.kernels.photometric.distortion` computes both):
 
 - chromaticity: ``c`` within ``k`` times the pixel's own chromaticity noise
   level (:func:`chroma_noise`: read from the window's ``D`` and ``L`` the way
@@ -35,35 +36,10 @@ Workshop, 1999.
 
 """
 
-import numpy as np
-
-from .kernels.texture import descriptor_distance, RELATIVE_THRESHOLD
+from .kernels.photometric import (explained_pixels, explained_pixels_reference, window_chroma,
+                                  window_chroma_reference)
 from .noise_levels import magnitude_noise
-
-# Smallest squared background norm: a black pixel has no chromaticity.
-_DARK = 1e-6
-
-
-def distortion(frame, background):
-    """
-    Return the brightness ratio ``alpha`` and chromaticity distortion ``c`` of a frame.
-
-    Parameters
-    ----------
-    frame, background : ndarray (C, ...)
-        Colour channels first, any trailing shape.
-
-    Returns
-    -------
-    alpha, chroma : ndarray (...) float32
-
-    """
-    frame = np.asarray(frame, dtype=np.float32)
-    background = np.asarray(background, dtype=np.float32)
-    energy = np.maximum(np.einsum('c...,c...->...', background, background), _DARK)
-    alpha = np.einsum('c...,c...->...', frame, background) / energy
-    across = frame - alpha[None] * background
-    return alpha, np.sqrt(np.einsum('c...,c...->...', across, across))
+from ..numba_setup import reference_unless
 
 
 def chroma_noise(data, residual, shape, observed=None, uniform=False, sample=None):
@@ -89,10 +65,7 @@ def chroma_noise(data, residual, shape, observed=None, uniform=False, sample=Non
         (:func:`~dgmod_ros.core.streaming.foreground.pixel_noise`); None: every pixel.
 
     """
-    from .kernels.photometric import window_chroma     # numba: loaded on first use
-    chroma = window_chroma(data, residual)
-    if chroma is None:
-        _, chroma = distortion(data, data - residual)
+    chroma = reference_unless(window_chroma, window_chroma_reference, data, residual)
     return magnitude_noise(chroma, shape, observed, uniform, sample)   # a distance: >= 0
 
 
@@ -148,34 +121,13 @@ class LightingTest:
         of :meth:`explains_reference` bit for bit.
 
         """
-        from .kernels.photometric import explained_pixels     # numba: loaded on first use
-        explained = explained_pixels(columns, background, noise, k, shape, candidates,
-                                     chroma_level, self.chroma, self.texture, self.texture_bits)
-        if explained is None:
-            return self.explains_reference(columns, background, noise, k, shape, candidates,
-                                           chroma_level)
-        return explained
+        return reference_unless(explained_pixels, explained_pixels_reference, columns,
+                                background, noise, k, shape, candidates, chroma_level,
+                                self.chroma, self.texture, self.texture_bits)
 
     def explains_reference(self, columns, background, noise, k, shape, candidates,
                            chroma_level=None):
         """Return :meth:`explains` computed in numpy (what the tests compare with)."""
-        pixels = np.flatnonzero(candidates)
-        explained = np.zeros(candidates.shape, dtype=bool)
-        if pixels.size == 0:
-            return explained
-        level = np.broadcast_to(np.asarray(noise, dtype=np.float32), candidates.shape)[pixels]
-        frame, reference = columns[:, pixels], background[:, pixels]
-        alpha, chroma = distortion(frame, reference)
-        light = np.abs(alpha - 1.0) <= RELATIVE_THRESHOLD
-        if self.chroma:
-            chroma_level = level if chroma_level is None else chroma_level[pixels]
-            light &= chroma <= k * chroma_level
-        if self.texture:
-            rows, cols, channels = shape
-            threshold = np.maximum(RELATIVE_THRESHOLD * reference, k * level)
-            bits = descriptor_distance(columns.reshape(channels, rows, cols),
-                                       background.reshape(channels, rows, cols),
-                                       threshold, pixels)
-            light &= bits <= self.texture_bits
-        explained[pixels] = light
-        return explained
+        return explained_pixels_reference(columns, background, noise, k, shape, candidates,
+                                          chroma_level, self.chroma, self.texture,
+                                          self.texture_bits)

@@ -3,7 +3,7 @@
 """
 The compiled sweeps of the Potts field's mean-field decision (same masks as numpy, bit for bit).
 
-:func:`~dgmod_ros.core.streaming.coherence.mean_field_mask_reference` spends
+:func:`mean_field_spins_reference` spends
 a sweep in nine numpy passes over the frame (box filter, subtraction, scaling,
 addition, clip, halving, tanh and their temporaries). Here a sweep is one
 serial ``nogil`` pass (:func:`_sweep`) plus numpy's ``tanh`` on the few
@@ -32,6 +32,7 @@ numba's process-wide settings come with ``njit`` from
 :mod:`~dgmod_ros.core.numba_setup`.
 """
 
+import cv2
 import numpy as np
 
 from ...numba_setup import njit, register_pass
@@ -251,6 +252,23 @@ def mean_field_spins(distance, noise, k, beta, rows, cols, sweeps, radius, z_cap
     return spin
 
 
+def mean_field_spins_reference(distance, noise, k, beta, rows, cols, sweeps, radius, z_cap,
+                               logit_cap):
+    """Return :func:`mean_field_spins` computed in numpy and OpenCV, for any inputs."""
+    k = np.reshape(np.asarray(k, dtype=np.float32), -1)
+    z = np.minimum(np.reshape(distance, -1) / noise, z_cap * k)
+    unary = ((z * z - k * k) / 2).astype(np.float32).reshape(rows, cols)
+    side = 2 * int(radius) + 1
+    spin = np.where(unary > 0, np.float32(1), np.float32(-1))      # the plain rule
+    for _ in range(int(sweeps)):
+        # Sum of the neighbours' expected spins (the pixel itself excluded).
+        neighbours = cv2.boxFilter(spin, -1, (side, side), normalize=False,
+                                   borderType=cv2.BORDER_REPLICATE) - spin
+        logit = np.clip(unary + beta * neighbours, -logit_cap, logit_cap)
+        spin = np.tanh(logit / 2)                  # 2 q - 1 with q = sigmoid(logit)
+    return spin
+
+
 def _examples():
     """Return fields of a frame with blobs: one noise level and k for all, or each pixel's own."""
     rng = np.random.default_rng(0)
@@ -264,4 +282,4 @@ def _examples():
             (distance, noise, k, 1.3, rows, cols, 5, 2, 3.0, 50.0)]
 
 
-register_pass(mean_field_spins, _examples)
+register_pass(mean_field_spins, _examples, mean_field_spins_reference)

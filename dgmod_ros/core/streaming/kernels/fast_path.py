@@ -111,6 +111,20 @@ def weighted_normal_equations(basis, columns, coef, floor, gram, rhs):
     kernel(basis, columns, coef, floor, gram, rhs)
 
 
+def irls_weights(residual, floor):
+    """Return the IRLS weights ``1 / max(|e|, floor)`` of an l1 fit's residual ``e``."""
+    return 1.0 / np.maximum(np.abs(residual), floor)
+
+
+def weighted_normal_equations_reference(basis, columns, coef, floor, gram, rhs):
+    """Compute :func:`weighted_normal_equations` in numpy (BLAS sums, in another order)."""
+    fitted = np.matmul(basis, coef.astype(np.float32)[:, :, None])[:, :, 0]
+    weighted = (irls_weights(columns - fitted, np.float32(floor))[:, :, None]
+                * basis).astype(np.float64)                                  # (C, n, r)
+    gram[:] = np.matmul(weighted.transpose(0, 2, 1), basis)
+    rhs[:] = np.matmul(weighted.transpose(0, 2, 1), columns[:, :, None])[:, :, 0]
+
+
 def _examples():
     """Return a frame's fit at ranks 1 (a still scene), 2 (the default) and 3 (any other)."""
     rng = np.random.default_rng(0)
@@ -123,4 +137,6 @@ def _examples():
     return examples
 
 
-register_pass(weighted_normal_equations, _examples)
+# Float32 products summed in float64 in another order (fastmath reassociates).
+register_pass(weighted_normal_equations, _examples, weighted_normal_equations_reference,
+              atol=1e-6, rtol=1e-5)

@@ -3,7 +3,7 @@
 """
 The lighting test in one compiled pass over the candidate pixels (same answers as numpy).
 
-:meth:`~dgmod_ros.core.streaming.photometric.LightingTest.explains_reference`
+:func:`explained_pixels_reference`
 gathers the candidates' colours, forms the brightness ratio and the
 chromaticity distortion in a dozen numpy passes and describes every
 candidate's texture. :func:`explained_pixels` visits each candidate once:
@@ -24,11 +24,33 @@ import math
 
 import numpy as np
 
-from .texture import channel_bits, OFFSETS, RELATIVE_THRESHOLD, window_offsets
+from .texture import channel_bits, descriptor_distance, OFFSETS, RELATIVE_THRESHOLD, window_offsets
 from ...numba_setup import njit, register_pass
 
-# The reference's smallest squared background norm, as numpy's float32 comparison takes it.
+# Smallest squared background norm: a black pixel has no chromaticity.
 _DARK = np.float32(1e-6)
+
+
+def distortion(frame, background):
+    """
+    Return the brightness ratio ``alpha`` and chromaticity distortion ``c`` of a frame.
+
+    Parameters
+    ----------
+    frame, background : ndarray (C, ...)
+        Colour channels first, any trailing shape.
+
+    Returns
+    -------
+    alpha, chroma : ndarray (...) float32
+
+    """
+    frame = np.asarray(frame, dtype=np.float32)
+    background = np.asarray(background, dtype=np.float32)
+    energy = np.maximum(np.einsum('c...,c...->...', background, background), _DARK)
+    alpha = np.einsum('c...,c...->...', frame, background) / energy
+    across = frame - alpha[None] * background
+    return alpha, np.sqrt(np.einsum('c...,c...->...', across, across))
 
 
 @njit(cache=True, nogil=True, inline='always')
@@ -144,11 +166,42 @@ def _window_chroma(data, residual, chroma):
             out[i] = math.sqrt(across[i])
 
 
+def explained_pixels_reference(columns, background, noise, k, shape, candidates, chroma_level,
+                               use_chroma, use_texture, texture_bits):
+    """
+    Return :func:`explained_pixels`'s answer computed in numpy, for any inputs.
+
+    The texture cue's LBSP distance is the compiled
+    :func:`~dgmod_ros.core.streaming.kernels.texture.descriptor_distance`
+    (checked against its own reference): what this reference states is how
+    the cues combine.
+    """
+    pixels = np.flatnonzero(candidates)
+    explained = np.zeros(candidates.shape, dtype=bool)
+    if pixels.size == 0:
+        return explained
+    level = np.broadcast_to(np.asarray(noise, dtype=np.float32), candidates.shape)[pixels]
+    frame, reference = columns[:, pixels], background[:, pixels]
+    alpha, chroma = distortion(frame, reference)
+    light = np.abs(alpha - 1.0) <= RELATIVE_THRESHOLD
+    if use_chroma:
+        chroma_level = level if chroma_level is None else chroma_level[pixels]
+        light &= chroma <= k * chroma_level
+    if use_texture:
+        rows, cols, channels = shape
+        threshold = np.maximum(RELATIVE_THRESHOLD * reference, k * level)
+        bits = descriptor_distance(columns.reshape(channels, rows, cols),
+                                   background.reshape(channels, rows, cols), threshold, pixels)
+        light &= bits <= texture_bits
+    explained[pixels] = light
+    return explained
+
+
 def window_chroma(data, residual):
     """
     Return the chromaticity distortion (n, m) float32 of a window against ``D - residual``.
 
-    :func:`~dgmod_ros.core.streaming.photometric.distortion`'s second output
+    :func:`distortion`'s second output
     for ``(data, data - residual)`` in one pass, without its (C, n, m)
     temporaries; None for inputs that are not float32 (the caller runs numpy).
     """
@@ -159,6 +212,11 @@ def window_chroma(data, residual):
     _window_chroma(np.ascontiguousarray(data).reshape(channels, -1),
                    np.ascontiguousarray(residual).reshape(channels, -1), chroma.reshape(-1))
     return chroma
+
+
+def window_chroma_reference(data, residual):
+    """Return :func:`window_chroma` computed in numpy, for any inputs."""
+    return distortion(data, data - residual)[1]
 
 
 def _explain_examples():
@@ -183,5 +241,5 @@ def _chroma_examples():
     return [(data, rng.normal(0, 0.05, data.shape).astype(np.float32))]
 
 
-register_pass(explained_pixels, _explain_examples)
-register_pass(window_chroma, _chroma_examples)
+register_pass(explained_pixels, _explain_examples, explained_pixels_reference)
+register_pass(window_chroma, _chroma_examples, window_chroma_reference)

@@ -122,6 +122,24 @@ def descriptor_distance(frame, background, threshold, pixels):
     return out
 
 
+def descriptor_distance_reference(frame, background, threshold, pixels):
+    """Return :func:`descriptor_distance` computed in numpy, the border replicated by padding."""
+    channels, rows, cols = frame.shape
+    pixels = np.asarray(pixels, dtype=np.int64)
+    row, col = pixels // cols + REACH, pixels % cols + REACH
+    reach = ((0, 0), (REACH, REACH), (REACH, REACH))
+    padded_frame = np.pad(np.asarray(frame, dtype=np.float32), reach, mode='edge')
+    padded_background = np.pad(np.asarray(background, dtype=np.float32), reach, mode='edge')
+    centre = padded_background[:, row, col]                        # (C, p)
+    limit = np.asarray(threshold, dtype=np.float32)
+    bits = np.zeros(pixels.shape[0], dtype=np.int64)
+    for dr, dc in PATTERN:
+        in_frame = np.abs(padded_frame[:, row + dr, col + dc] - centre) > limit
+        in_background = np.abs(padded_background[:, row + dr, col + dc] - centre) > limit
+        bits += (in_frame != in_background).sum(axis=0)
+    return bits.astype(np.uint8)
+
+
 def _examples():
     """Return a frame and its background with some pixels inside and on the border."""
     rng = np.random.default_rng(0)
@@ -132,4 +150,4 @@ def _examples():
     return [(frame, background, threshold, pixels)]
 
 
-register_pass(descriptor_distance, _examples)
+register_pass(descriptor_distance, _examples, descriptor_distance_reference)
