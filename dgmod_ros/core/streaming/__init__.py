@@ -3,26 +3,34 @@
 """
 Streaming detection: a mask for every frame, window solves apart from the frames.
 
-Modules, one job each:
+The path a frame takes, in order (:meth:`SlidingWindowDetector.process_frame`
+and its ``_finish``), one module per stage:
 
-- :mod:`.contract`: :class:`StreamingDetector`, the contract every detector the
-  node and ``dgmod separate --mode stream`` run implements, and the solve
-  protocol (tickets that tie a solve to the detector and configuration that
-  started it).
-- :mod:`.results`: what detectors hand out (:class:`FrameResult`,
-  :class:`WindowSnapshot`, :class:`BackgroundModel`, :class:`SolverFailure`).
-- :mod:`.settings`: parameter checks and all-or-nothing reconfiguration.
-- :mod:`.buffer`: the buffered frames of a window, their rescaling, and the
-  scene-change rule that restarts the window.
-- :mod:`.background_memory`: the window's columns, admitted every few frames
-  with their foreground replaced by the background (conditional update).
-- :mod:`.fast_path`: a frame's background from the last solve (l1 projection by IRLS).
-- :mod:`.foreground`: the decision: each pixel against its own noise level, the ghost test.
-- :mod:`.photometric`: the lighting test of the decision (brightness ratio,
-  chromaticity), which drops shadows and reflections.
-- :mod:`.texture`: the LBSP descriptor distance between a frame and its background.
-- :mod:`.window_solve`: one window solve, snapshot in, background model out.
-- :mod:`.sliding_window`: :class:`SlidingWindowDetector`, which puts them together.
+1. :mod:`.buffer`: the frame joins the buffered frames of the window (their
+   rescaling; the scene-change rule that restarts the window is the last step).
+2. :mod:`.fast_path`: its background from the last solve, an l1 projection by
+   IRLS (before the first solve: each pixel's median of the buffered frames).
+3. :mod:`.noise_levels`: each pixel's own noise level, read from the last solve.
+4. :mod:`.decision`: each pixel's distance against its level, with
+   :mod:`.coherence` (the Potts field over the per-pixel rule) and
+   :mod:`.photometric` (the lighting test: shadows and reflections dropped).
+5. The blob rules, on one labelling (:mod:`.blobs`): :mod:`.ghost` (blobs where
+   the background is wrong) and :mod:`.held_foreground` (blobs nothing moves in).
+6. :mod:`.upsizing`: the mask at the camera's size.
+7. :mod:`.background_memory`: the frame admitted to the window every few frames,
+   its foreground replaced by the background (conditional update).
+
+Apart from the frames, in the solve thread: :mod:`.window_solve` (a window
+snapshot in, a background model out) and :mod:`.solve_resolution` (the solve
+at a capped size, the full-size background carried from it).
+
+Around them: :mod:`.contract` (:class:`StreamingDetector`, the contract every
+detector the node and ``dgmod separate --mode stream`` run implements, and the
+solve protocol), :mod:`.results` (what detectors hand out),
+:mod:`.settings` (parameter checks, all-or-nothing reconfiguration) and
+:mod:`.sliding_window` (:class:`SlidingWindowDetector`, which runs the
+stages). The compiled passes sit apart in :mod:`.kernels`, one module per
+stage they serve, each beside its numpy reference.
 
 OpenCV's subtractors implement the same contract in
 :class:`dgmod_ros.core.subtractors.OpenCVSubtractor`.

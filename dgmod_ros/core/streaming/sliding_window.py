@@ -397,45 +397,10 @@ class SlidingWindowDetector(StreamingDetector):
         return background, model.noise
 
     def _finish(self, pending):
+        # The stages in the order a frame passes them (the package docstring's list).
         result, columns = pending
-        rows, cols, _ = self.shape_
         background, level = self._background(columns)
-        if self.decision == 'global':
-            result.magnitude = np.abs(columns - background).max(axis=0).reshape(rows, cols)
-            result.mask = self.mask_rule_.apply(result.magnitude, level, self.input_shape_)
-            foreground = np.where(result.magnitude > level, np.uint8(255), np.uint8(0))
-            changed = result.mask
-        else:
-            model = self.background_model_
-            earlier = (self.recent_[0][1] if len(self.recent_) == self.recent_.maxlen
-                       else None)
-            foreground, result.magnitude = adaptive_mask(
-                columns, background, level, self.pixel_k, self.shape_, self.median_size,
-                self.mrf_beta, self.lighting_,
-                model.chroma_noise if model is not None else None, earlier,
-                self.moving_texture_k, int(self.moving_texture_bits))
-            # The scene-change rule counts every change, light included: after
-            # the lights of most of the view switch, the lighting test would
-            # hide the change while the window still holds the old light.
-            changed = result.magnitude.ravel() > self.pixel_k * level
-            if ((self.ghost_test or self.still_frames) and self.background_model_ is not None
-                    and earlier is not None):
-                # One labelling for both tests: the ghost test drops whole blobs.
-                blobs = BlobMotion(foreground, columns, earlier, level)
-                before = foreground > 0
-                # Each pixel's change against the earlier frame, for the rules
-                # below that ask it of single pixels.
-                change = np.abs(columns - earlier).max(axis=0)
-                moved = moved_inside(foreground, self.foreground_age_, change, level,
-                                     self.pixel_k, _GHOST_LAG)
-                self.entered_ = moved if self.entered_ is None else moved | self.entered_
-                if self.ghost_test:
-                    blobs.drop(ghost_labels(blobs, foreground, columns, background,
-                                            self.pixel_k), foreground)
-                if self.still_frames:
-                    self._drop_still(foreground, columns, level, blobs)
-                self._note_healing(columns, change, level, before, foreground)
-            result.mask = to_input_size(foreground, self.input_shape_)
+        foreground, changed = self._decide(result, columns, background, level)
         result.buffered = self._admit(columns, background, foreground, result.frame_id,
                                       result.magnitude, level)
         self.recent_.append((result.frame_id, columns))
@@ -446,6 +411,53 @@ class SlidingWindowDetector(StreamingDetector):
                                                            self.global_change_fraction):
             self._restart_from_newest(SceneChangeWatch.FRAMES)
         return result
+
+    def _decide(self, result, columns, background, level):
+        """
+        Set ``result``'s magnitude and mask; return the processing-size foreground and the changes.
+
+        The foreground (rows, cols) uint8 is what the window admits the frame
+        with; the changes (n,) bool are what the scene-change rule counts.
+        """
+        rows, cols, _ = self.shape_
+        if self.decision == 'global':
+            result.magnitude = np.abs(columns - background).max(axis=0).reshape(rows, cols)
+            result.mask = self.mask_rule_.apply(result.magnitude, level, self.input_shape_)
+            foreground = np.where(result.magnitude > level, np.uint8(255), np.uint8(0))
+            return foreground, result.mask
+        model = self.background_model_
+        earlier = self.recent_[0][1] if len(self.recent_) == self.recent_.maxlen else None
+        foreground, result.magnitude = adaptive_mask(
+            columns, background, level, self.pixel_k, self.shape_, self.median_size,
+            self.mrf_beta, self.lighting_, model.chroma_noise if model is not None else None,
+            earlier, self.moving_texture_k, int(self.moving_texture_bits))
+        # The scene-change rule counts every change, light included: after
+        # the lights of most of the view switch, the lighting test would
+        # hide the change while the window still holds the old light.
+        changed = result.magnitude.ravel() > self.pixel_k * level
+        if ((self.ghost_test or self.still_frames) and model is not None
+                and earlier is not None):
+            self._blob_rules(foreground, columns, background, level, earlier)
+        result.mask = to_input_size(foreground, self.input_shape_)
+        return foreground, changed
+
+    def _blob_rules(self, foreground, columns, background, level, earlier):
+        """Drop, in place, the ghost blobs and the blobs held still from ``foreground``."""
+        # One labelling for both tests: the ghost test drops whole blobs.
+        blobs = BlobMotion(foreground, columns, earlier, level)
+        before = foreground > 0
+        # Each pixel's change against the earlier frame, for the rules
+        # below that ask it of single pixels.
+        change = np.abs(columns - earlier).max(axis=0)
+        moved = moved_inside(foreground, self.foreground_age_, change, level, self.pixel_k,
+                             _GHOST_LAG)
+        self.entered_ = moved if self.entered_ is None else moved | self.entered_
+        if self.ghost_test:
+            blobs.drop(ghost_labels(blobs, foreground, columns, background, self.pixel_k),
+                       foreground)
+        if self.still_frames:
+            self._drop_still(foreground, columns, level, blobs)
+        self._note_healing(columns, change, level, before, foreground)
 
     def _drop_still(self, foreground, columns, level, blobs):
         """Clear, in place, the pixels of ``foreground`` held still for ``still_frames``."""
