@@ -24,6 +24,7 @@ from .core.dgmod import DualGraphMOD
 from .core.masks import MaskRule
 from .core.streaming import SlidingWindowDetector
 from .core.subtractors import OpenCVSubtractor, OpenCVWindowModel
+from .core.validation import options
 
 
 #: Where a parameter can be read: the node, ``dgmod --mode stream`` (the node's
@@ -62,6 +63,11 @@ class Not:
 def _allowed(value):
     """Normalise one ``active_when`` value: a :class:`Not`, or a tuple of the allowed values."""
     return value if isinstance(value, (Not, tuple)) else (value,)
+
+
+def _choices(owner, name):
+    """Return the values ``owner`` accepts for ``name``: the choices the core declares."""
+    return options(owner._parameter_constraints[name])
 
 
 #: ``active_when`` shorthands: the dual-graph model's own weights and solver; a
@@ -140,7 +146,8 @@ PARAMETERS = (
               'decision) and the window; masks come back at input size. The window solve runs '
               'at this scale up to solve_pixels', 0.05, 1.0, acts=EVERYWHERE),
     Parameter('color', 'rgb', 'gray: one luma channel; rgb: each channel solved, fused by '
-              'the largest magnitude', choices=('gray', 'rgb'), acts=EVERYWHERE),
+              'the largest magnitude', choices=_choices(SlidingWindowDetector, 'color'),
+              acts=EVERYWHERE),
     Parameter('min_frames', 5, 'frames before the first solve (<= window); until then masks '
               'use the per-pixel median of the buffer', 2, 300, active_when=_WINDOW),
     Parameter('basis_rank', 2, 'background components the per-frame fast path projects on',
@@ -197,7 +204,7 @@ PARAMETERS = (
     Parameter('temporal_neighbors', 4, 'frames joined to each frame in the temporal graph',
               2, 20, acts=EVERYWHERE, active_when=_DGMOD),
     Parameter('l_step', 'gradient', 'L-step: gradient (paper) or exact (block CG in the '
-              'temporal eigenbasis)', choices=('gradient', 'exact'), acts=EVERYWHERE,
+              'temporal eigenbasis)', choices=_choices(DualGraphMOD, 'l_step'), acts=EVERYWHERE,
               active_when=_DGMOD, advanced=True),
     Parameter('inner_iter', 1, 'gradient steps or CG iterations per L-step (T_in)', 1, 50,
               acts=EVERYWHERE, active_when=_DGMOD, advanced=True),
@@ -234,12 +241,12 @@ PARAMETERS = (
     Parameter('decision', 'adaptive', 'adaptive: each pixel against pixel_k times its own noise '
               "level from the window's residual; uniform: one level for all pixels; global: "
               'the mask_* rule (one threshold, morphology)',
-              choices=('adaptive', 'uniform', 'global'), active_when=_WINDOW),
+              choices=_choices(SlidingWindowDetector, 'decision'), active_when=_WINDOW),
     Parameter('noise_source', 'solve', "residual of the window that gives each pixel's noise "
               "level: solve: the solve's D - L; projection / least_squares: each frame against "
               "its robust / least-squares projection on the fast path's basis (what the per-frame "
               'decision thresholds); max: the larger of the solve and projection levels',
-              choices=('solve', 'projection', 'least_squares', 'max'), active_when=_PER_PIXEL,
+              choices=_choices(SlidingWindowDetector, 'noise_source'), active_when=_PER_PIXEL,
               advanced=True),
     Parameter('ghost_test', True, 'drop still blobs whose outline is an edge of the background '
               'rather than of the frame (ghosts of what has left); they heal the window',

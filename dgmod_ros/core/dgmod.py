@@ -3,6 +3,7 @@
 """The robust dual-graph regularized separation model and its ADMM solver."""
 
 from dataclasses import dataclass, replace
+from numbers import Integral, Real
 
 import numpy as np
 
@@ -12,6 +13,7 @@ from .linalg import (drop_oldest, frames_major, gram_eigh, gram_matrix, mixing_f
                      relative_change, row_median, shrink, singular_value_map,
                      top_singular_value)
 from .runtime import limit_blas_threads
+from .validation import Interval, Options, validate_params
 from .window_data import check_window_data
 
 
@@ -168,6 +170,22 @@ class DualGraphMOD:
     #: Whether the objective has the weighted nuclear norm (FRPCAG's has not).
     _nuclear_norm = True
 
+    _POSITIVE = [Interval(Real, 0, None, closed='neither')]
+    _NON_NEGATIVE = [Interval(Real, 0, None)]
+    _COUNT = [Interval(Integral, 1, None)]
+    #: The parameters' constraints (:mod:`~dgmod_ros.core.validation`), in checking order.
+    _parameter_constraints = {
+        'lambda2': _POSITIVE, 'rho1': _POSITIVE, 'rho2': _POSITIVE, 'tol': _POSITIVE,
+        'gamma1': _NON_NEGATIVE, 'gamma2': _NON_NEGATIVE, 'smoothing_sigma': _NON_NEGATIVE,
+        'lambda1': [None] + _NON_NEGATIVE,
+        'weight_scale': [None] + _POSITIVE, 'h_s': [None] + _POSITIVE,
+        'h_t': [None] + _POSITIVE, 'step_size': [None] + _POSITIVE,
+        'l_step': [Options('gradient', 'exact')], 'svd': [Options('gram', 'full')],
+        'engine': [Options('fused', 'numpy')],
+        'patch_size': [Interval(Integral, 1, None, odd=True)],
+        'inner_iter': _COUNT, 'max_iter': _COUNT, 'temporal_neighbors': _COUNT,
+    }
+
     def __init__(self, lambda1=None, lambda2=0.5, gamma1=0.5, gamma2=0.5, rho1=20.0, rho2=20.0,
                  weight_scale=None, h_s=None, h_t=None, patch_size=3, smoothing_sigma=0.0,
                  temporal_neighbors=4, l_step='gradient', inner_iter=1, step_size=None,
@@ -195,35 +213,7 @@ class DualGraphMOD:
     # ------------------------------------------------------------------ checks
     def check_parameters(self):
         """Raise ``ValueError`` naming the first unusable parameter; return self."""
-        positive = ('lambda2', 'rho1', 'rho2', 'tol')
-        for name in positive:
-            value = getattr(self, name)
-            if not (np.isfinite(value) and value > 0):
-                raise ValueError(f'{name} must be a positive finite number, got {value!r}')
-        for name in ('gamma1', 'gamma2', 'smoothing_sigma'):
-            value = getattr(self, name)
-            if not (np.isfinite(value) and value >= 0):
-                raise ValueError(f'{name} must be a non-negative finite number, got {value!r}')
-        if self.lambda1 is not None and not (np.isfinite(self.lambda1) and self.lambda1 >= 0):
-            raise ValueError(f'lambda1 must be None or a non-negative finite number, '
-                             f'got {self.lambda1!r}')
-        for name in ('weight_scale', 'h_s', 'h_t', 'step_size'):
-            value = getattr(self, name)
-            if value is not None and not (np.isfinite(value) and value > 0):
-                raise ValueError(f'{name} must be None or a positive finite number, got {value!r}')
-        if self.l_step not in ('exact', 'gradient'):
-            raise ValueError(f"l_step must be 'exact' or 'gradient', got {self.l_step!r}")
-        if self.svd not in ('gram', 'full'):
-            raise ValueError(f"svd must be 'gram' or 'full', got {self.svd!r}")
-        if self.engine not in ('fused', 'numpy'):
-            raise ValueError(f"engine must be 'fused' or 'numpy', got {self.engine!r}")
-        if int(self.patch_size) != self.patch_size or self.patch_size < 1 \
-                or self.patch_size % 2 == 0:
-            raise ValueError(f'patch_size must be a positive odd integer, got {self.patch_size!r}')
-        for name in ('inner_iter', 'max_iter', 'temporal_neighbors'):
-            value = getattr(self, name)
-            if int(value) != value or value < 1:
-                raise ValueError(f'{name} must be a positive integer, got {value!r}')
+        validate_params(self)
         return self
 
     def _validate(self, data, frame_shape):

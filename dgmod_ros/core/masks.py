@@ -22,10 +22,13 @@ optional morphological opening (speckle) and closing (holes) with an elliptic
 ``morph_size x morph_size`` kernel is applied.
 """
 
+from numbers import Integral, Real
+
 import cv2
 import numpy as np
 
 from .preprocess import to_uint8
+from .validation import Interval, Options, validate_params
 
 # Enough samples for a stable median; larger windows are subsampled with a
 # fixed stride so that the estimate is deterministic.
@@ -61,6 +64,13 @@ class MaskRule:
 
     """
 
+    _parameter_constraints = {
+        'threshold': [Options('auto'), Interval(Real, 0, None, closed='neither')],
+        'k': [Interval(Real, 0, None, closed='neither')],
+        'min_threshold': [Interval(Real, 0, None)],
+        'morph_size': [Interval(Integral, 0, None)],
+    }
+
     def __init__(self, threshold='auto', k=5.0, min_threshold=0.1, morph_size=3):
         self.threshold = threshold
         self.k = k
@@ -69,19 +79,7 @@ class MaskRule:
 
     def validate(self):
         """Raise ``ValueError`` for an unusable parameter; return self."""
-        if isinstance(self.threshold, str):
-            if self.threshold != 'auto':
-                raise ValueError(f"threshold must be a positive number or 'auto', "
-                                 f'got {self.threshold!r}')
-        elif not (np.isfinite(self.threshold) and self.threshold > 0):
-            raise ValueError(f'threshold must be positive, got {self.threshold!r}')
-        if not (np.isfinite(self.k) and self.k > 0):
-            raise ValueError(f'k must be positive, got {self.k!r}')
-        if not (np.isfinite(self.min_threshold) and self.min_threshold >= 0):
-            raise ValueError(f'min_threshold must be non-negative, got {self.min_threshold!r}')
-        if int(self.morph_size) != self.morph_size or self.morph_size < 0:
-            raise ValueError(f'morph_size must be a non-negative integer, got {self.morph_size!r}')
-        return self
+        return validate_params(self)
 
     def estimate_threshold(self, residual, frames=None):
         """

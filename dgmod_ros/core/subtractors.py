@@ -2,6 +2,8 @@
 # Licensed under the Apache License, Version 2.0
 """OpenCV's per-frame subtractors: a streaming detector and a window method."""
 
+from numbers import Integral
+
 import cv2
 import numpy as np
 
@@ -9,7 +11,8 @@ from .masks import clean_mask
 from .preprocess import processing_shape, resize, to_float_channels, to_uint8
 from .streaming.contract import StreamingDetector
 from .streaming.results import FrameResult, SolverFailure
-from .streaming.settings import assign_validated, check_scale_and_color
+from .streaming.settings import assign_validated, COLOR, COUNT, SCALE
+from .validation import Interval, Options, validate_params
 from .window_data import check_window_data
 
 _FACTORIES = {
@@ -55,6 +58,9 @@ class OpenCVSubtractor(StreamingDetector):
 
     """
 
+    _parameter_constraints = {'kind': [Options(*_FACTORIES)], 'scale': SCALE, 'color': COLOR,
+                              'morph_size': [Interval(Integral, 0, None)], 'stride': COUNT}
+
     def __init__(self, kind='mog2', scale=0.5, color='gray', morph_size=3, stride=10):
         self.kind = kind
         self.scale = scale
@@ -64,14 +70,7 @@ class OpenCVSubtractor(StreamingDetector):
 
     def validate(self):
         """Check the parameters; raise ``ValueError`` naming the bad one."""
-        if self.kind not in _FACTORIES:
-            raise ValueError(f"kind must be 'mog2' or 'knn', got {self.kind!r}")
-        check_scale_and_color(self.scale, self.color)
-        if int(self.morph_size) != self.morph_size or self.morph_size < 0:
-            raise ValueError(f'morph_size must be a non-negative integer, got {self.morph_size!r}')
-        if int(self.stride) != self.stride or self.stride < 1:
-            raise ValueError(f'stride must be a positive integer, got {self.stride!r}')
-        return self
+        return validate_params(self)
 
     def reset(self):
         """Start a new background model."""

@@ -1,80 +1,49 @@
 # Copyright 2026 dgmod_ros authors
 # Licensed under the Apache License, Version 2.0
-"""Parameter checks of the streaming detectors and their all-or-nothing reconfiguration."""
+"""The streaming detectors' parameter constraints and their all-or-nothing reconfiguration."""
 
 import inspect
+from numbers import Integral, Real
 
-import numpy as np
-
-from ..masks import MaskRule
+from ..validation import Interval, Options
 
 # Residuals the per-pixel noise level may come from (see window_solve.window_noise).
 NOISE_SOURCES = ('solve', 'projection', 'least_squares', 'max')
 
+#: The processing scale and the colour mode, shared by every streaming detector.
+SCALE = [Interval(Real, 0, 1, closed='right')]
+COLOR = [Options('gray', 'rgb')]
+COUNT = [Interval(Integral, 1, None)]
+NON_NEGATIVE = [Interval(Real, 0, None)]
+#: LBSP Hamming distances: 16 bits a channel, three channels at most.
+TEXTURE_BITS = [Interval(Integral, 0, 48)]
 
-def _require_scale(name, value):
-    """Raise ``ValueError`` unless ``value`` is a number in (0, 1]."""
-    if not (isinstance(value, (int, float)) and 0 < value <= 1):
-        raise ValueError(f'{name} must be in (0, 1], got {value!r}')
-
-
-def check_scale_and_color(scale, color):
-    """Raise ``ValueError`` for a processing scale outside (0, 1] or an unknown colour mode."""
-    _require_scale('scale', scale)
-    if color not in ('gray', 'rgb'):
-        raise ValueError(f"color must be 'gray' or 'rgb', got {color!r}")
-
-
-def _require_integer(name, value, low, high=None, high_label=None):
-    """Raise ``ValueError`` unless ``value`` is an integer in ``[low, high]`` (None: no bound)."""
-    if int(value) == value and low <= value and (high is None or value <= high):
-        return
-    if high is None:
-        raise ValueError(f'{name} must be an integer >= {low}, got {value!r}')
-    raise ValueError(f'{name} must be an integer in [{low}, {high_label or high}], '
-                     f'got {value!r}')
-
-
-def _require_non_negative(name, value):
-    """Raise ``ValueError`` unless ``value`` is a finite number >= 0."""
-    if not (np.isfinite(value) and value >= 0):
-        raise ValueError(f'{name} must be >= 0, got {value!r}')
-
-
-def check_window_parameters(detector):
-    """Raise ``ValueError`` naming the first bad parameter of a sliding-window detector."""
-    window, stride = detector.window, detector.stride
-    _require_integer('window', window, 2)
-    _require_integer('stride', stride, 1, window, f'window={window}')
-    check_scale_and_color(detector.scale, detector.color)
-    _require_non_negative('motion_threshold', detector.motion_threshold)
-    _require_integer('min_frames', detector.min_frames, 2, window, f'window={window}')
-    if not 0 < detector.global_change_fraction <= 1:
-        raise ValueError(f'global_change_fraction must be in (0, 1], got '
-                         f'{detector.global_change_fraction!r}')
-    _require_integer('basis_rank', detector.basis_rank, 1)
-    _require_integer('memory_spacing', detector.memory_spacing, 1)
-    _require_integer('absorb_frames', detector.absorb_frames, 1)
-    if detector.decision not in ('adaptive', 'uniform', 'global'):
-        raise ValueError(f"decision must be 'adaptive', 'uniform' or 'global', "
-                         f'got {detector.decision!r}')
-    if detector.noise_source not in NOISE_SOURCES:
-        raise ValueError(f'noise_source must be one of {NOISE_SOURCES}, '
-                         f'got {detector.noise_source!r}')
-    if not (np.isfinite(detector.pixel_k) and detector.pixel_k > 0):
-        raise ValueError(f'pixel_k must be positive, got {detector.pixel_k!r}')
-    size = detector.median_size
-    if int(size) != size or size < 1 or size % 2 == 0:
-        raise ValueError(f'median_size must be an odd positive integer, got {size!r}')
-    _require_integer('still_frames', detector.still_frames, 0)
-    _require_non_negative('mrf_beta', detector.mrf_beta)
-    _require_integer('texture_bits', detector.texture_bits, 0, 48)
-    _require_non_negative('moving_texture_k', detector.moving_texture_k)
-    _require_integer('moving_texture_bits', detector.moving_texture_bits, 0, 48)
-    _require_integer('solve_lag', detector.solve_lag, 0)
-    _require_integer('solve_pixels', detector.solve_pixels, 1)
-    _require_scale('solve_scale', detector.solve_scale)
-    (detector.mask_rule or MaskRule()).validate()
+#: :class:`~dgmod_ros.core.streaming.sliding_window.SlidingWindowDetector`'s
+#: constraints (:mod:`~dgmod_ros.core.validation`), in the order they are checked.
+WINDOW_CONSTRAINTS = {
+    'window': [Interval(Integral, 2, None)],
+    'stride': [Interval(Integral, 1, 'window')],
+    'scale': SCALE,
+    'color': COLOR,
+    'motion_threshold': NON_NEGATIVE,
+    'min_frames': [Interval(Integral, 2, 'window')],
+    'global_change_fraction': [Interval(Real, 0, 1, closed='right')],
+    'basis_rank': COUNT,
+    'memory_spacing': COUNT,
+    'absorb_frames': COUNT,
+    'decision': [Options('adaptive', 'uniform', 'global')],
+    'noise_source': [Options(*NOISE_SOURCES)],
+    'pixel_k': [Interval(Real, 0, None, closed='neither')],
+    'median_size': [Interval(Integral, 1, None, odd=True)],
+    'still_frames': [Interval(Integral, 0, None)],
+    'mrf_beta': NON_NEGATIVE,
+    'texture_bits': TEXTURE_BITS,
+    'moving_texture_k': NON_NEGATIVE,
+    'moving_texture_bits': TEXTURE_BITS,
+    'solve_lag': [Interval(Integral, 0, None)],
+    'solve_pixels': COUNT,
+    'solve_scale': SCALE,
+}
 
 
 def assign_validated(target, params):

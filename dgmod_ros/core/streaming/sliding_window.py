@@ -24,13 +24,14 @@ from .kernels.warmup_background import entry_medians
 from .noise_levels import warmup_noise
 from .photometric import LightingTest
 from .results import FrameResult, WindowSnapshot
-from .settings import assign_validated, check_window_parameters
+from .settings import assign_validated, WINDOW_CONSTRAINTS
 from .solve_resolution import ColumnCache, solve_shape
 from .upsizing import to_input_size
 from .window_solve import solve_window
 from ..dgmod import DualGraphMOD
 from ..masks import MaskRule
 from ..preprocess import frame_columns, processing_shape
+from ..validation import validate_params
 
 # Frames back to the frame that tells whether a blob is still (the ghost test).
 _GHOST_LAG = 5
@@ -229,6 +230,8 @@ class SlidingWindowDetector(StreamingDetector):
 
     """
 
+    _parameter_constraints = WINDOW_CONSTRAINTS
+
     def __init__(self, model=None, window=30, stride=10, scale=0.5, color='rgb',
                  mask_rule=None, motion_threshold=0.0, min_frames=5, basis_rank=2,
                  global_change_fraction=0.7, memory_spacing=10, conditional_update=True,
@@ -272,7 +275,8 @@ class SlidingWindowDetector(StreamingDetector):
     # ------------------------------------------------------------- set-up
     def validate(self):
         """Check the parameters; raise ``ValueError`` naming the bad one."""
-        check_window_parameters(self)
+        validate_params(self)
+        (self.mask_rule or MaskRule()).validate()
         self._validated = True
         return self
 
