@@ -90,7 +90,7 @@ def test_non_convergence_is_reported_in_info():
     ({'lambda2': 0.0}, 'lambda2 must be a positive'),
     ({'rho1': -1.0}, 'rho1 must be a positive'),
     ({'gamma1': -0.1}, 'gamma1 must be a non-negative'),
-    ({'l_step': 'newton'}, "l_step must be 'exact' or 'gradient'"),
+    ({'l_step': 'newton'}, "l_step must be 'gradient' or 'exact'"),
     ({'svd': 'qr'}, "svd must be 'gram' or 'full'"),
     ({'patch_size': 4}, 'patch_size must be a positive odd'),
     ({'max_iter': 0}, 'max_iter must be a positive integer'),

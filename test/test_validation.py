@@ -51,7 +51,10 @@ def test_options_and_none_and_their_words():
     allowed = [None, Options('auto'), Interval(Real, 0, None, closed='neither')]
     assert satisfies(allowed, None) and satisfies(allowed, 'auto') and satisfies(allowed, 2.0)
     assert not satisfies(allowed, 'Auto') and not satisfies(allowed, 0.0)
-    assert describe(allowed) == "None or one of 'auto' or a number > 0"
+    assert describe(allowed) == "None or 'auto' or a positive finite number"
+    assert describe([Interval(Real, 0, 1, closed='right')]) == 'a finite number in (0, 1]'
+    assert describe([Interval(Integral, 1, None, odd=True)]) == 'a positive odd integer'
+    assert describe([Options('a', 'b', 'c')]) == "one of 'a', 'b', 'c'"
 
 
 def test_validate_params_names_the_first_bad_parameter_in_declaration_order():

@@ -70,18 +70,24 @@ class Interval:
 
     def describe(self, owner=None):
         """Return what a valid value is, in words (the error messages')."""
-        noun = ('an odd integer' if self.odd else 'an integer') if self.kind is Integral \
-            else 'a number'
+        noun = ('odd integer' if self.odd else 'integer') if self.kind is Integral \
+            else 'finite number'
         low, high = self.bounds(owner)
+        left = self.closed in ('both', 'left')
+        if high is None and low == 0:       # the common ranges, in their common words
+            return f'a {"non-negative" if left else "positive"} {noun}'
+        if high is None and low == 1 and self.kind is Integral and left:
+            return f'a positive {noun}'
+        article = 'an' if noun[0] in 'aeiou' else 'a'
         names = [f'{bound}={value}' if isinstance(bound, str) else f'{value}'
                  for bound, value in ((self.low, low), (self.high, high))]
         if high is None:
             if low is None:
-                return noun
-            return f'{noun} {">=" if self.closed in ("both", "left") else ">"} {names[0]}'
-        opening = '[' if self.closed in ('both', 'left') else '('
+                return f'{article} {noun}'
+            return f'{article} {noun} {">=" if left else ">"} {names[0]}'
+        opening = '[' if left else '('
         closing = ']' if self.closed in ('both', 'right') else ')'
-        return f'{noun} in {opening}{names[0]}, {names[1]}{closing}'
+        return f'{article} {noun} in {opening}{names[0]}, {names[1]}{closing}'
 
 
 class Options:
@@ -96,6 +102,8 @@ class Options:
 
     def describe(self, owner=None):
         """Return the options, in words."""
+        if len(self.values) <= 2:
+            return ' or '.join(repr(value) for value in self.values)
         return 'one of ' + ', '.join(repr(value) for value in self.values)
 
 
