@@ -124,8 +124,11 @@ class CompiledPass:
         Returns fresh argument tuples (each called afresh: a pass may write
         into its arguments), every specialisation the package's callers
         compile among them.
-    atol : float
-        Largest absolute difference allowed to the reference; 0.0: bit for bit.
+    atol, rtol : float
+        Largest absolute and relative differences allowed to the reference
+        (``numpy.testing.assert_allclose``'s); both 0.0: bit for bit. A pass
+        compiled with ``fastmath`` reassociates its sums, so it agrees with
+        its reference to rounding only.
 
     """
 
@@ -134,6 +137,7 @@ class CompiledPass:
     reference: Callable
     examples: Callable
     atol: float = 0.0
+    rtol: float = 0.0
 
     def warm_up(self):
         """Compile (or load from the cache) the pass on each of its examples."""
@@ -145,9 +149,8 @@ class CompiledPass:
 PASSES = []
 
 
-def register_pass(compiled, examples, reference=None, atol=0.0):
+def register_pass(compiled, examples, reference=None, atol=0.0, rtol=0.0):
     """Register a pass, its examples and its reference; return its :class:`CompiledPass`."""
     name = f'{compiled.__module__.removeprefix("dgmod_ros.")}.{compiled.__name__}'
-    PASSES.append(CompiledPass(name, compiled, reference, examples, atol))
+    PASSES.append(CompiledPass(name, compiled, reference, examples, atol, rtol))
     return PASSES[-1]
-    return compiled
