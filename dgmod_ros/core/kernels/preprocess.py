@@ -83,16 +83,20 @@ def _examples():
     Return frames of 8 and 16 bits, writeable and read-only, in both channel orders.
 
     Writeable and read-only frames both (a frame viewing a message's bytes
-    is read-only), since numba compiles each apart.
+    is read-only), since numba compiles each apart; and four-channel frames
+    with a smaller value range than the type's (values clipped to 1), which
+    compile nothing more.
     """
     rng = np.random.default_rng(0)
     examples = []
     for dtype in (np.uint8, np.uint16):
+        top = np.iinfo(dtype).max
         for writeable in (True, False):
-            top = np.iinfo(dtype).max
             frame = rng.integers(0, top, (24, 32, 3), endpoint=True).astype(dtype)
             frame.setflags(write=writeable)
             examples.extend((frame, 1.0 / top, reverse) for reverse in (False, True))
+        frame = rng.integers(0, top, (24, 32, 4), endpoint=True).astype(dtype)
+        examples.extend((frame, 1.0 / (0.8 * top), reverse) for reverse in (False, True))
     return examples
 
 
