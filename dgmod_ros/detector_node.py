@@ -25,7 +25,6 @@ import threading
 import time
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
-import numpy as np
 from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
                                 SetParametersResult)
 import rclpy
@@ -38,15 +37,15 @@ from rclpy.qos_overriding_options import QoSOverridingOptions
 from sensor_msgs.msg import CompressedImage, Image
 from std_srvs.srv import Trigger
 
-from . import config
+from . import config, health, node_parameters
 from .core.masks import overlay
-from .core.numba_setup import use_threads
-from .core.preprocess import to_float_channels, to_uint8
-from .core.runtime import keep_freed_memory, yield_to_compute
+from .core.preprocess import to_float_channels
+from .core.runtime import keep_freed_memory
 from .core.streaming import SolverFailure
 from .depth_outputs import DepthOutputs
-from .image_conversion import (compressed_image_to_array, fill_image, image_to_array,
-                               ImageConversionError, stamp_ns)
+from .detector_rules import EncodingWatch, mask_frame, solve_job, solve_thread_settings
+from .image_conversion import (background_fields, compressed_image_to_array, fill_image,
+                               image_to_array, ImageConversionError, stamp_ns)
 from .solve_worker import SolveWorker
 from .stats import DetectorStats
 from .transport import LargeImageCheck
@@ -71,18 +70,6 @@ def _descriptor(spec):
     return descriptor
 
 
-# Nice increment of the solve thread (Linux: per thread). Where the cores
-# are contended, the image callback, whose delay is every mask's, runs
-# before the solve, whose delay only ages the background (docs/node.md,
-# "scale:=1.0 on a loaded machine").
-SOLVE_THREAD_NICENESS = 10
-
-
-def _solve_thread_settings(threads):
-    use_threads(threads)
-    yield_to_compute(SOLVE_THREAD_NICENESS)
-
-
 class StartupError(RuntimeError):
     """autostart could not configure or activate the node (the reason was logged)."""
 
@@ -101,11 +88,10 @@ class DetectorNode(LifecycleNode):
             self.declare_parameter(spec.name, spec.default, _descriptor(spec))
             self._values[spec.name] = self.get_parameter(spec.name).value
         config.validate(self._values)       # a bad parameter file stops the node here
-        self._warn_inert(self._values, self._set_by_user(self._values))
-        for name in getattr(self, '_parameter_overrides', {}):   # rclpy keeps the overrides
-            if name in config.BY_NAME and not self.has_parameter(name):
-                reason = config.inert_reason(name, self._values, config.NODE)
-                self.get_logger().warning(f'{name} is not a node parameter: {reason}')
+        self._warn(node_parameters.inert_warnings(
+            self._values, node_parameters.set_by_user(self._values)))
+        self._warn(node_parameters.not_node_warnings(     # rclpy keeps the overrides
+            getattr(self, '_parameter_overrides', {}), self.has_parameter, self._values))
         self._lock = threading.Lock()       # guards the detector between callbacks
         self._stats = DetectorStats()
         self._detector = None               # built by configure
@@ -113,11 +99,9 @@ class DetectorNode(LifecycleNode):
         self._active = False
         self._lifecycle_state = 'unconfigured'
         self._large_images = LargeImageCheck()
-        self._encoding = None
+        self._encoding = EncodingWatch()
         self._frames_ignored = 0
-        self._foreground_share = None
-        self._foreground_jumps = 0
-        self._jump_reported = 0
+        self._foreground = health.ForegroundWatch()
         self._subscription = None
         self._mask_pub = self._background_pub = self._overlay_pub = None
         self._depth = None
@@ -155,10 +139,10 @@ class DetectorNode(LifecycleNode):
         keep_freed_memory()     # the solves' large temporaries reused, not mapped afresh
         with self._lock:
             self._detector = detector
-            self._encoding = None
-            self._foreground_share = None
-        self._worker = SolveWorker(self._solve, self._on_solved, self._on_solve_error,
-                                   initializer=partial(_solve_thread_settings,
+            self._encoding.reset()
+            self._foreground.reset()
+        self._worker = SolveWorker(solve_job, self._on_solved, self._on_solve_error,
+                                   initializer=partial(solve_thread_settings,
                                                        self._values['solve_threads']))
         sensor_qos = {'callback_group': self._image_group, 'qos_overriding_options':
                       QoSOverridingOptions.with_default_policies()}
@@ -179,13 +163,8 @@ class DetectorNode(LifecycleNode):
                                        self._publish_mask, self._on_depth_scene_change)
         self._apply_node_parameters()
         self._lifecycle_state = 'inactive'
-        self.get_logger().info(
-            f"detector configured: method {self._values['method']}, window "
-            f"{self._values['window']}, stride {self._values['stride']}, scale "
-            f"{self._values['scale']}, solve_mode {self._values['solve_mode']}, input "
-            f"{self._subscription.topic_name if self._subscription else 'depth only'} "
-            f"({self._values['input_transport']}), depth "
-            f"{'on' if self._depth else 'off'}")
+        self.get_logger().info(node_parameters.configured_line(
+            self._values, self._subscription and self._subscription.topic_name, self._depth))
         return TransitionCallbackReturn.SUCCESS
 
     def on_activate(self, state):
@@ -265,27 +244,17 @@ class DetectorNode(LifecycleNode):
             return
         value_range = self._values['value_range'] or None
         with self._lock:
-            if self._encoding is not None and encoding != self._encoding:
-                # Same size, other meaning (colour to depth, say): restart too.
+            previous = self._encoding.changed(encoding)
+            if previous is not None:
                 self._detector.reset()
                 self._stats.window_reset()
-                self.get_logger().info(f'encoding changed from {self._encoding} to '
+                self.get_logger().info(f'encoding changed from {previous} to '
                                        f'{encoding}: window restarted')
-            self._encoding = encoding
             detector = self._detector
             try:
-                if self._values['solve_mode'] == 'sync':
-                    result, solved = detector.process(image, order or 'rgb', value_range)
-                else:
-                    # A solve left in flight by the sync mode is installed here.
-                    result = detector.push(image, order or 'rgb', value_range)
-                    solved = result.installed
-                    if detector.solve_due():
-                        self._stats.solve_due()
-                        if not self._worker.busy:
-                            # The job names its detector: the result is installed
-                            # only there, and only in the same configuration.
-                            self._worker.submit((detector, detector.snapshot()))
+                result, solved = mask_frame(detector, image, order or 'rgb', value_range,
+                                            self._values['solve_mode'], self._worker,
+                                            self._stats.solve_due)
             except ValueError as error:
                 self._stats.drop('invalid')
                 self.get_logger().warning(f'dropped a frame: {error}',
@@ -314,26 +283,18 @@ class DetectorNode(LifecycleNode):
     def _publish_mask(self, header, mask, received):
         self._mask_pub.publish(fill_image(Image(), mask, 'mono8', header))
         self._stats.masked(time.monotonic() - received)
-        self._watch_foreground_share(mask)
+        jump = self._foreground.observe(mask, self._values['foreground_jump'])
+        if jump is not None:
+            self.get_logger().warning(health.jump_warning(*jump),
+                                      throttle_duration_sec=_WARN_PERIOD)
 
     def _on_depth_scene_change(self):
         """Restart the window: the depth background restarted (the camera moved)."""
         with self._lock:
             if self._detector is not None:
                 self._detector.reset()
-            self._foreground_share = None
+            self._foreground.reset()
         self._stats.window_reset()
-
-    def _watch_foreground_share(self, mask):
-        """Count jumps of the foreground share between consecutive frames."""
-        share = float(np.count_nonzero(mask)) / mask.size
-        previous, self._foreground_share = self._foreground_share, share
-        if previous is not None and abs(share - previous) > self._values['foreground_jump']:
-            self._foreground_jumps += 1
-            self.get_logger().warning(
-                f'foreground share jumped from {previous:.0%} to {share:.0%} of the frame: '
-                'camera moved or lights changed? (~/reset_background restarts the window)',
-                throttle_duration_sec=_WARN_PERIOD)
 
     def _on_reset_background(self, request, response):
         with self._lock:
@@ -342,7 +303,7 @@ class DetectorNode(LifecycleNode):
                 response.message = f'not configured (state {self._lifecycle_state})'
                 return response
             self._detector.reset()
-            self._foreground_share = None
+            self._foreground.reset()
             if self._depth is not None:
                 self._depth.reset_background()
         self._stats.window_reset()
@@ -352,11 +313,6 @@ class DetectorNode(LifecycleNode):
         return response
 
     # ----------------------------------------------------------------- solves
-    @staticmethod
-    def _solve(job):
-        detector, snapshot = job
-        return detector.solve(snapshot)
-
     def _on_solved(self, job, model):
         with self._lock:
             if self._detector is None:
@@ -384,11 +340,7 @@ class DetectorNode(LifecycleNode):
     def _publish_background(self, image, header):
         if self._background_pub is None:
             return
-        pixels = to_uint8(image)
-        if pixels.shape[2] == 1:
-            pixels = pixels[:, :, 0]
-        encoding = 'mono8' if pixels.ndim == 2 else 'rgb8'
-        self._background_pub.publish(fill_image(Image(), pixels, encoding, header))
+        self._background_pub.publish(fill_image(Image(), *background_fields(image), header))
 
     def _publish_overlay(self, image, order, value_range, mask, header):
         pixels = overlay(to_float_channels(image, order or 'rgb', 'rgb', value_range), mask)
@@ -397,8 +349,7 @@ class DetectorNode(LifecycleNode):
     # ----------------------------------------------------------------- parameters
     def _check_parameters(self, parameters):
         # Only the table's parameters: configure declares qos_overrides.* too.
-        candidate = dict(self._values)
-        candidate.update({p.name: p.value for p in parameters if p.name in config.BY_NAME})
+        candidate = dict(self._values, **node_parameters.table_changes(parameters))
         try:
             config.validate(candidate)
         except ValueError as error:
@@ -406,7 +357,7 @@ class DetectorNode(LifecycleNode):
         return SetParametersResult(successful=True)
 
     def _apply_parameters(self, parameters):
-        changed = {p.name: p.value for p in parameters if p.name in config.BY_NAME}
+        changed = node_parameters.table_changes(parameters)
         if not changed:
             return
         previous = self._values
@@ -419,21 +370,12 @@ class DetectorNode(LifecycleNode):
                 self._depth.configure(values)
             self._values = values
         self._apply_node_parameters()
-        self.get_logger().info('parameters changed: ' + ', '.join(
-            f'{name}={value}' for name, value in sorted(changed.items())))
-        # The changed ones that do nothing, and those set before that this change made inert.
-        before = config.inert_parameters(previous, self._set_by_user(previous), config.NODE)
-        self._warn_inert(values, set(changed) | (self._set_by_user(values) - set(before)))
+        self.get_logger().info(node_parameters.change_line(changed))
+        self._warn(node_parameters.change_warnings(previous, values, changed))
 
-    @staticmethod
-    def _set_by_user(values):
-        # A full parameter file repeats the defaults: only other values count as set.
-        return {spec.name for spec in config.reads(config.NODE)
-                if values[spec.name] != spec.default}
-
-    def _warn_inert(self, values, names):
-        for name, reason in config.inert_parameters(values, names, config.NODE).items():
-            self.get_logger().warning(f'{name}={values[name]} has no effect: {reason}')
+    def _warn(self, lines):
+        for line in lines:
+            self.get_logger().warning(line)
 
     def _apply_node_parameters(self):
         configured = self._mask_pub is not None
@@ -456,55 +398,26 @@ class DetectorNode(LifecycleNode):
     # ----------------------------------------------------------------- diagnostics
     def statistics(self):
         """Return the node's counters and figures as a dict."""
-        figures = self._stats.snapshot()
-        figures['lifecycle_state'] = self._lifecycle_state
-        figures['frames_ignored_inactive'] = self._frames_ignored
-        figures['foreground_jumps'] = self._foreground_jumps
-        if self._foreground_share is not None:
-            figures['foreground_share'] = round(self._foreground_share, 4)
-        if self._depth is not None:
-            figures.update(self._depth.statistics())
+        return health.node_figures(self._stats, self._lifecycle_state, self._frames_ignored,
+                                   self._foreground, self._detector_status, self._depth,
+                                   self._values['depth_only'], self._worker)
+
+    def _detector_status(self):
         with self._lock:
-            if self._detector is not None:
-                figures.update(self._detector.status())
-            else:
-                figures.update(window_frames=0, model_ready=False)
-        if self._values['depth_only']:
-            figures['model_ready'] = figures.get('depth_model_ready', False)
-        if self._worker is not None:
-            figures['worker_callback_errors'] = self._worker.callback_errors
-        return figures
+            return self._detector.status() if self._detector is not None else None
 
     def diagnostic_status(self):
         """Return the node's ``DiagnosticStatus``: WARN with the problems, else OK."""
         figures = self.statistics()
         status = DiagnosticStatus(name=f'{self.get_name()}: foreground detection',
                                   hardware_id=self.get_fully_qualified_name())
-        problems = []
-        if figures['frames_dropped']:
-            problems.append(f"{figures['frames_dropped']} frames dropped")
-        if figures['solve_failures']:
-            problems.append(f"{figures['solve_failures']} solves failed")
-        if self._lifecycle_state != 'active':
-            problems.append(f'{self._lifecycle_state}: not masking frames')
-        elif not figures['model_ready']:
-            problems.append('warming up: no background model yet')
         timeout = self._values['solve_timeout']
-        if self._stats.solve_overdue(timeout):
-            problems.append(f"no window solve finished for {figures['solve_wait_s']:.0f} s "
-                            f'while frames arrive (solve_timeout {timeout} s): the '
-                            'background is frozen')
-        malformed_depth = self._depth.malformed() if self._depth is not None else 0
-        if malformed_depth:
-            problems.append(f'{malformed_depth} malformed depth images or camera infos dropped')
-        jumps = self._foreground_jumps
-        if jumps > self._jump_reported:
-            problems.append(f'foreground share jumped {jumps - self._jump_reported} times '
-                            f'by more than {self._values["foreground_jump"]:.0%} of the frame '
-                            '(camera moved, lights?)')
-            self._jump_reported = jumps
+        problems = health.problems(
+            figures, self._lifecycle_state, self._stats.solve_overdue(timeout), timeout,
+            self._depth.malformed() if self._depth is not None else 0,
+            self._foreground.unreported(), self._values['foreground_jump'])
         status.level = DiagnosticStatus.WARN if problems else DiagnosticStatus.OK
-        status.message = '; '.join(problems) or 'masks published for every frame'
+        status.message = health.status_message(problems)
         status.values = [KeyValue(key=key, value=str(value)) for key, value in figures.items()]
         return status
 

@@ -15,6 +15,8 @@ does; numpy 2 has no ``ndarray.newbyteorder``, so the dtype carries the order.
 import cv2
 import numpy as np
 
+from .core.preprocess import to_uint8
+
 #: encoding -> (numpy dtype, channels, channel order of colour images)
 ENCODINGS = {
     'mono8': (np.uint8, 1, None),
@@ -157,6 +159,14 @@ def fill_image(msg, image, encoding, header=None):
 
 
 #: Depth encodings (REP 118): 16-bit millimetres or 32-bit float metres.
+def background_fields(image):
+    """Return ``(pixels, encoding)`` of a float [0, 1] (h, w, C) image: mono8, or rgb8 (C 3)."""
+    pixels = to_uint8(image)
+    if pixels.shape[2] == 1:
+        pixels = pixels[:, :, 0]
+    return pixels, 'mono8' if pixels.ndim == 2 else 'rgb8'
+
+
 DEPTH_ENCODINGS = ('16UC1', 'mono16', '32FC1')
 
 

@@ -49,7 +49,12 @@ def camera_info_message(k, shape, stamp_ns=0, frame_id='depth_optical'):
 
 
 class DetectorHarness:
-    """The node under test plus a client node that publishes frames and collects outputs."""
+    """
+    The node under test plus a client node that publishes frames and collects outputs.
+
+    A context manager: ``with DetectorHarness(**parameters) as harness:``
+    closes it however the block ends.
+    """
 
     def __init__(self, **overrides):
         self.context = Context()
@@ -186,7 +191,14 @@ class DetectorHarness:
         """Wait until the solver thread is idle."""
         assert self.node._worker.wait_idle(timeout)
 
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc_info):
+        self.close()
+
     def close(self):
+        """Stop the executor, the nodes and the context (``with DetectorHarness() as h`` does)."""
         self.executor.shutdown()
         self.node.destroy_node()
         self.client.destroy_node()

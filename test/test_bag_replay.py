@@ -24,8 +24,7 @@ def test_bag_through_node_matches_offline_stream_masks(tmp_path, parameters):
     scene = synthetic_scene(n_frames=40, shape=(96, 128), seed=8)
     bag = write_image_bag(tmp_path / 'bag', scene.frames)
 
-    harness = DetectorHarness(**parameters)
-    try:
+    with DetectorHarness(**parameters) as harness:
         node_masks = []
         with Reader(bag) as reader:
             for connection, _, raw in reader.messages():
@@ -34,8 +33,6 @@ def test_bag_through_node_matches_offline_stream_masks(tmp_path, parameters):
         # Solves at 5 (installed at once), then every 5 frames, each installed
         # solve_lag = 5 frames later: the one taken at frame 35 is still in flight.
         assert harness.node.statistics()['solves'] >= 6
-    finally:
-        harness.close()
 
     params = tmp_path / 'detector.yaml'
     params.write_text(yaml.safe_dump({'/detector': {'ros__parameters': parameters}}))

@@ -45,8 +45,7 @@ def _figures(harness, scene, cloud, depth, person):
 
 def _replay(scene, frames, encoding='16UC1', period_ns=33_333_333, **parameters):
     """Send ``frames`` frames of ``scene`` in-process; return per-frame figures."""
-    harness = DetectorHarness(**dict(PARAMETERS, **parameters))
-    try:
+    with DetectorHarness(**dict(PARAMETERS, **parameters)) as harness:
         harness.send_camera_info(camera_info_message(scene.k, scene.shape, T0))
         figures = []
         for t in range(frames):
@@ -54,8 +53,6 @@ def _replay(scene, frames, encoding='16UC1', period_ns=33_333_333, **parameters)
             cloud = harness.send_rgbd(image, depth_msg)
             figures.append(_figures(harness, scene, cloud, depth, person))
         return np.array(figures), harness.node.statistics()
-    finally:
-        harness.close()
 
 
 def _replay_bag(tmp_path, scene, frames, encoding, period_ns, **parameters):
@@ -69,16 +66,13 @@ def _replay_bag(tmp_path, scene, frames, encoding, period_ns, **parameters):
                      camera_info_message(scene.k, scene.shape, stamp), stamp + 1),
                     ('/camera/depth/image_rect_raw', depth_msg, stamp + 2)]
     bag = write_message_bag(tmp_path / 'rgbd', entries, 'mcap')
-    harness = DetectorHarness(**dict(PARAMETERS, **parameters))
-    try:
+    with DetectorHarness(**dict(PARAMETERS, **parameters)) as harness:
         figures = []
         for t, (_, cloud) in enumerate(harness.replay_rgbd(read_message_bag(bag))):
             _, depth, person = scene.frame(t)
             figures.append(_figures(harness, scene, cloud, depth, person))
         assert len(figures) == frames
         return np.array(figures), harness.node.statistics()
-    finally:
-        harness.close()
 
 
 @pytest.mark.parametrize('replay, encoding, rate', [('in-process', '16UC1', 30),
@@ -138,8 +132,7 @@ def test_depth_finds_the_person_colour_cannot_tell_from_the_wall(case, encoding)
 def test_invalid_depth_patches_are_left_to_the_colour_mask():
     scene = WalkAndStop(shape=SHAPE, empty_frames=30, walk_frames=45, invalid_patches=True,
                         **NOISE)
-    harness = DetectorHarness(**PARAMETERS)
-    try:
+    with DetectorHarness(**PARAMETERS) as harness:
         harness.send_camera_info(camera_info_message(scene.k, scene.shape, T0))
         for t in range(120):
             image, depth_msg, depth, person = _messages(scene, t, '16UC1', 33_333_333)
@@ -150,8 +143,6 @@ def test_invalid_depth_patches_are_left_to_the_colour_mask():
         assert np.mean(mask[head]) > 0.9 and np.mean(mask[wall]) < 0.05
         share, covered = coverage(point_cloud_to_array(cloud), person, depth, scene.k, STEP)
         assert share > 0.98 and covered > 0.95     # no points without a reading
-    finally:
-        harness.close()
 
 
 def _call_reset(harness):
@@ -166,8 +157,7 @@ def test_the_camera_moved_restarts_depth_and_window_together():
     before = WalkAndStop(shape=SHAPE, empty_frames=1000, **NOISE)        # nobody there
     after = WalkAndStop(shape=SHAPE, empty_frames=30, walk_frames=45, wall_depth=3.6, seed=3,
                         **NOISE)
-    harness = DetectorHarness(**PARAMETERS)
-    try:
+    with DetectorHarness(**PARAMETERS) as harness:
         harness.send_camera_info(camera_info_message(before.k, before.shape, T0))
         period = 33_333_333
         for t in range(40):
@@ -187,15 +177,12 @@ def test_the_camera_moved_restarts_depth_and_window_together():
         assert harness.node._depth._model.ready_
         assert _call_reset(harness).success
         assert not harness.node._depth._model.ready_
-    finally:
-        harness.close()
 
 
 def test_depth_only_mode_masks_and_clouds_from_depth_alone():
     scene = WalkAndStop(shape=SHAPE, empty_frames=15, walk_frames=30, person_value=None,
                         **NOISE)
-    harness = DetectorHarness(**dict(PARAMETERS, depth_only=True))
-    try:
+    with DetectorHarness(**dict(PARAMETERS, depth_only=True)) as harness:
         assert {s.topic_name for s in harness.node.subscriptions} == {
             '/depth/image_rect', '/depth/camera_info'}
         harness.send_camera_info(camera_info_message(scene.k, scene.shape, T0))
@@ -210,14 +197,11 @@ def test_depth_only_mode_masks_and_clouds_from_depth_alone():
         stats = harness.node.statistics()
         assert stats['model_ready'] and stats['frames_in'] == 0
         assert stats['clouds_out'] == stats['depth_in'] == 60
-    finally:
-        harness.close()
 
 
 def test_the_node_warns_once_when_colour_and_depth_exceed_the_default_segment(monkeypatch):
     monkeypatch.delenv(PROFILE_VARIABLE, raising=False)
-    harness = DetectorHarness(**PARAMETERS)
-    try:
+    with DetectorHarness(**PARAMETERS) as harness:
         logger = RecordingLogger(harness.node.get_logger())
         monkeypatch.setattr(harness.node, 'get_logger', lambda: logger)
         k = [200.0, 0.0, 160.0, 0.0, 200.0, 120.0, 0.0, 0.0, 1.0]
@@ -239,8 +223,6 @@ def test_the_node_warns_once_when_colour_and_depth_exceed_the_default_segment(mo
             harness.send_rgbd(image_message(rgb, 'rgb8', stamp),
                               depth_message(depth, '16UC1', stamp))
         assert len([text for text in logger.warnings if PROFILE_VARIABLE in text]) == 1
-    finally:
-        harness.close()
 
 
 def test_every_colour_frame_gets_its_mask_when_depth_is_lost_or_stops():

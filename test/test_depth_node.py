@@ -76,8 +76,7 @@ def _assert_figures(figures, frames):
 
 @pytest.mark.parametrize('encoding', ['16UC1', '32FC1'])
 def test_cloud_lies_on_the_body_in_process(scene, encoding):
-    harness = DetectorHarness(**PARAMETERS)
-    try:
+    with DetectorHarness(**PARAMETERS) as harness:
         harness.send_camera_info(camera_info_message(scene.k, SHAPE, T0))
         figures = []
         for index, frame in enumerate(scene.frames):
@@ -90,8 +89,6 @@ def test_cloud_lies_on_the_body_in_process(scene, encoding):
         stats = harness.node.statistics()
         assert stats['depth_in'] == stats['clouds_out'] == len(scene.frames)
         assert stats['depth_dropped'] == 0 and stats['masks_without_depth'] == 0
-    finally:
-        harness.close()
 
 
 @pytest.mark.parametrize('encoding, storage', [('16UC1', 'mcap'), ('32FC1', 'sqlite3')])
@@ -107,20 +104,16 @@ def test_cloud_lies_on_the_body_from_a_rosbag2(tmp_path, scene, encoding, storag
             ('/camera/depth/image_rect_raw', depth_message(scene.depth[index], encoding, stamp),
              stamp + 2)]
     bag = write_message_bag(tmp_path / 'rgbd', entries, storage)
-    harness = DetectorHarness(**PARAMETERS)
-    try:
+    with DetectorHarness(**PARAMETERS) as harness:
         figures = [_check_outputs(harness, scene, encoding, index, cloud, msg)
                    for index, (msg, cloud) in enumerate(harness.replay_rgbd(
                        read_message_bag(bag)))]
         assert len(figures) == len(scene.frames)
         _assert_figures(figures, len(scene.frames))
-    finally:
-        harness.close()
 
 
 def test_nobody_there_gives_empty_clouds(scene):
-    harness = DetectorHarness(**PARAMETERS)
-    try:
+    with DetectorHarness(**PARAMETERS) as harness:
         wall = np.full(SHAPE, scene.wall_depth, np.float32)
         empty = np.clip(scene.backgrounds[0][:, :, None] * 255, 0, 255).astype(np.uint8)
         empty = np.repeat(empty, 3, axis=2)
@@ -131,13 +124,10 @@ def test_nobody_there_gives_empty_clouds(scene):
                                       depth_message(wall, '16UC1', stamp))
             assert not mask_array(harness.masks[-1]).any()
             assert cloud.width == 0 and cloud.data.tolist() == [] and _stamp(cloud) == stamp
-    finally:
-        harness.close()
 
 
 def test_unpaired_and_malformed_depth_is_counted_and_dropped(scene):
-    harness = DetectorHarness(**PARAMETERS, depth_slop=0.005)
-    try:
+    with DetectorHarness(**PARAMETERS, depth_slop=0.005) as harness:
         depth = scene.depth[0]
         # Before any camera info: no intrinsics to project with.
         harness.send_depth(depth_message(depth, '16UC1', T0), expect_cloud=False)
@@ -171,5 +161,3 @@ def test_unpaired_and_malformed_depth_is_counted_and_dropped(scene):
                                        + figures['depth_waiting'])
         # Colour frames were all masked: depth faults never cost a mask.
         assert figures['masks_out'] == figures['frames_in'] == 2
-    finally:
-        harness.close()

@@ -23,9 +23,8 @@ SHAPE = (120, 160)
 @pytest.fixture
 def harness(request):
     overrides = getattr(request, 'param', {})
-    h = DetectorHarness(**overrides)
-    yield h
-    h.close()
+    with DetectorHarness(**overrides) as h:
+        yield h
 
 
 @pytest.fixture(scope='module')

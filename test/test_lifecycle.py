@@ -100,11 +100,8 @@ def test_transitions_from_unconfigured_to_finalized(scene):
 def test_subscribed_topics_are_the_ones_the_launch_file_remaps():
     topics = set()
     for overrides in ({'use_depth': True}, {'input_transport': 'compressed'}):
-        harness = DetectorHarness(**overrides)
-        try:
+        with DetectorHarness(**overrides) as harness:
             topics |= {s.topic_name for s in harness.node.subscriptions}
-        finally:
-            harness.close()
     assert topics == {'/' + topic for topic in SUBSCRIBED_TOPICS}
 
 
@@ -124,8 +121,7 @@ def _replay(frames, compression=None, check=None, **parameters):
     ``check(harness, publisher)`` runs on the still-open harness afterwards.
     """
     transport = 'raw' if compression is None else 'compressed'
-    harness = DetectorHarness(input_transport=transport, **parameters)
-    try:
+    with DetectorHarness(input_transport=transport, **parameters) as harness:
         if compression is None:
             publisher, messages = None, [image_message(f, 'rgb8') for f in frames]
         else:
@@ -135,8 +131,6 @@ def _replay(frames, compression=None, check=None, **parameters):
         if check is not None:
             check(harness, publisher)
         return masks
-    finally:
-        harness.close()
 
 
 def test_compressed_input_gives_the_raw_masks(scene):
@@ -172,8 +166,7 @@ def test_compressed_input_gives_the_raw_masks(scene):
 
 
 def test_reset_service_restarts_the_window(scene):
-    harness = DetectorHarness(solve_mode='sync', window=10, stride=5)
-    try:
+    with DetectorHarness(solve_mode='sync', window=10, stride=5) as harness:
         for frame in scene.frames[:8]:
             harness.send(image_message(frame, 'rgb8'))
         assert harness.node.statistics()['window_frames'] == 8
@@ -183,8 +176,6 @@ def test_reset_service_restarts_the_window(scene):
         assert figures['window_frames'] == 0 and figures['window_resets'] == 1
         harness.send(image_message(scene.frames[8], 'rgb8'))
         assert harness.node.statistics()['window_frames'] == 1
-    finally:
-        harness.close()
 
 
 def test_a_jump_of_the_foreground_share_warns_in_diagnostics(scene):

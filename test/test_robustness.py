@@ -20,9 +20,8 @@ def scene():
 
 @pytest.fixture
 def harness():
-    h = DetectorHarness(max_pixels=200_000)
-    yield h
-    h.close()
+    with DetectorHarness(max_pixels=200_000) as h:
+        yield h
 
 
 def _malformed(kind, frame):

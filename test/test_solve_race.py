@@ -41,9 +41,8 @@ def frames():
 
 @pytest.fixture
 def harness():
-    h = DetectorHarness(**PARAMETERS)
-    yield h
-    h.close()
+    with DetectorHarness(**PARAMETERS) as h:
+        yield h
 
 
 def _send(harness, frame):

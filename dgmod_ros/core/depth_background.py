@@ -74,7 +74,7 @@ class DepthBackground:
         but never put it farther away); 1.0 disables.
     compiled : bool, default=True
         Run the update as two compiled passes (:mod:`dgmod_ros.core.kernels.depth_background`);
-        False runs its numpy reference (the same results, bit for bit).
+        False runs their numpy references there (the same results, bit for bit).
 
     Attributes
     ----------
@@ -182,102 +182,34 @@ class DepthBackground:
         if self.background_ is None or self.background_.shape != depth.shape:
             self._start(depth.shape)
         depth = np.require(depth, np.float32, 'CW')     # the compiled passes' one layout
-        judge = self._judge_compiled if self.compiled else self._judge_numpy
-        verdict, judged, behind = judge(depth)
+        verdict, judged, behind = self._judge(depth)
         if self.change_fraction < 1 and judged >= _FEWEST_JUDGED * depth.size \
                 and behind > self.change_fraction * judged:
             self.scene_changes_ += 1
             self._start(depth.shape)          # and learnt from this image on
             verdict[:] = UNKNOWN
         self.frames_ += 1
-        (self._learn_compiled if self.compiled else self._learn_numpy)(depth)
+        self._learn(depth)
         return verdict
 
     def _scalars(self):
         return (np.float32(self.noise_k), np.float32(self.noise_base),
                 np.float32(self.noise_quadratic))
 
-    def _judge_compiled(self, depth):
+    def _judge(self, depth):
+        judge = depth_kernel.judge if self.compiled else depth_kernel.judge_reference
         verdict = np.empty(depth.shape, np.uint8)
-        judged, behind = depth_kernel.judge(
+        judged, behind = judge(
             depth.reshape(-1), self.background_.reshape(-1), self.hits_.reshape(-1),
             *self._scalars(), np.float32(self.learn_frames), verdict.reshape(-1))
         return verdict, judged, behind
 
-    def _learn_compiled(self, depth):
-        depth_kernel.learn(depth.reshape(-1), self.background_.reshape(-1),
-                           self.hits_.reshape(-1), self.near_frames_.reshape(-1),
-                           self._far_depth.reshape(-1), self._far_frames.reshape(-1),
-                           *self._scalars(), np.float32(self.span_frames),
-                           int(self.absorb_frames), int(self.learn_frames),
-                           int(self.reveal_frames))
-
-    # The numpy reference of the two compiled passes (the tests hold them equal).
-    def _relations(self, depth):
-        """Return where ``depth`` is nearer, behind, within the band, within half of it."""
-        with np.errstate(invalid='ignore'):
-            # NaN (no reading, or a pixel never seen) compares False everywhere.
-            offset = depth - self.background_
-            margin = np.float32(self.noise_k) * self.noise()
-            # Learnt from the readings within half the band only: a person just
-            # in front of the wall, whose noise reaches into the band now and
-            # then, would otherwise pull the mean, and the band, towards them.
-            return (offset < -margin, offset > margin, np.abs(offset) <= margin,
-                    np.abs(offset) <= np.float32(0.5) * margin)
-
-    def _judge_numpy(self, depth):
-        nearer, behind, match, _ = self._relations(depth)
-        trusted = self.hits_ >= np.float32(self.learn_frames)
-        verdict = np.zeros(depth.shape, np.uint8)
-        verdict[trusted & nearer] = FOREGROUND
-        verdict[trusted & (match | behind)] = BACKGROUND
-        return verdict, np.count_nonzero(verdict), np.count_nonzero(trusted & behind)
-
-    def _learn_numpy(self, depth):
-        nearer, behind, _, close = self._relations(depth)
-        background, hits = self.background_, self.hits_
-        first = np.isfinite(depth) & np.isnan(background)
-        # At the scene's depth: a running mean over up to span_frames readings.
-        count = np.minimum(hits + 1, np.float32(self.span_frames))
-        step = np.where(close, (depth - background) / count, np.float32(0))
-        np.add(background, step, out=background, where=close)
-        np.copyto(hits, count, where=close)
-        # Never seen before: the first reading starts the pixel.
-        np.copyto(background, depth, where=first)
-        np.copyto(hits, np.float32(1), where=first)
-        # In front: held out until absorb_frames readings (a parked object).
-        near = self.near_frames_
-        near += nearer
-        near[close | behind] = 0
-        absorbed = nearer & (near >= self.absorb_frames)
-        if absorbed.any():
-            np.copyto(background, depth, where=absorbed)
-            np.copyto(hits, np.float32(self.learn_frames), where=absorbed)
-            near[absorbed] = 0
-        # Behind, consistently: the scene uncovered.
-        self._reveal(depth, behind, close | nearer)
-
-    def _reveal(self, depth, behind, not_behind):
-        far, frames = self._far_depth, self._far_frames
-        with np.errstate(invalid='ignore'):
-            margin = np.float32(self.noise_k) * depth_noise(far, self.noise_base,
-                                                            self.noise_quadratic)
-            agrees = behind & (np.abs(depth - far) <= margin)
-        restart = behind & ~agrees
-        np.copyto(far, depth, where=restart)
-        frames[restart] = 1
-        count = (frames + 1).astype(np.float32)
-        np.add(far, (depth - far) / count, out=far, where=agrees)
-        frames += agrees
-        frames[not_behind] = 0
-        revealed = frames >= self.reveal_frames
-        if revealed.any():
-            np.copyto(self.background_, far, where=revealed)
-            # Trusted at once: the scene's far side, seen reveal_frames times.
-            np.copyto(self.hits_, np.maximum(frames, self.learn_frames).astype(np.float32),
-                      where=revealed)
-            self.near_frames_[revealed] = 0
-            frames[revealed] = 0
+    def _learn(self, depth):
+        learn = depth_kernel.learn if self.compiled else depth_kernel.learn_reference
+        learn(depth.reshape(-1), self.background_.reshape(-1), self.hits_.reshape(-1),
+              self.near_frames_.reshape(-1), self._far_depth.reshape(-1),
+              self._far_frames.reshape(-1), *self._scalars(), np.float32(self.span_frames),
+              int(self.absorb_frames), int(self.learn_frames), int(self.reveal_frames))
 
 
 def fuse_masks(verdict, colour_mask=None):

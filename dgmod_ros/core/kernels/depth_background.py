@@ -8,7 +8,9 @@ image against its model and then learns from it. In numpy that is about
 thirty passes over (h, w) arrays with their temporaries (9 ms at 640 x 480
 here); :func:`judge` and :func:`learn` read each pixel's state once and do
 the same float32 arithmetic in the same order: the same model and verdicts,
-bit for bit (``test/test_depth_background.py``). Serial and ``nogil``: the
+bit for bit, as their numpy references :func:`judge_reference` and
+:func:`learn_reference` (``test/test_compiled_passes.py``,
+``test/test_depth_background.py``). Serial and ``nogil``: the
 depth callback runs beside the solve thread, whose kernels own the threads.
 numba's process-wide settings come with ``njit`` from
 :mod:`~dgmod_ros.core.numba_setup`.
@@ -99,6 +101,72 @@ def learn(depth, background, hits, near, far, far_frames, k, base, quadratic, sp
             far_frames[i] = 0
 
 
+# The numpy references of the two passes: the same arguments, the same
+# results, written into the same arrays (DepthBackground(compiled=False)).
+def _relations(depth, background, k, base, quadratic):
+    """Return where ``depth`` is nearer, behind, within half the band of ``background``."""
+    with np.errstate(invalid='ignore'):
+        # NaN (no reading, or a pixel never seen) compares False everywhere.
+        offset = depth - background
+        margin = k * (base + quadratic * background * background)
+        # Learnt from the readings within half the band only: a person just
+        # in front of the wall, whose noise reaches into the band now and
+        # then, would otherwise pull the mean, and the band, towards them.
+        return (offset < -margin, offset > margin,
+                np.abs(offset) <= np.float32(0.5) * margin)
+
+
+def judge_reference(depth, background, hits, k, base, quadratic, learn_frames, verdict):
+    """Write :func:`judge`'s verdicts into ``verdict``; return its counts, in numpy."""
+    nearer, behind, _ = _relations(depth, background, k, base, quadratic)
+    # A trusted pixel with a reading is judged: in front, else at or behind.
+    judged = (hits >= learn_frames) & ~np.isnan(depth)
+    verdict[:] = 0
+    verdict[judged] = 1
+    verdict[judged & nearer] = 2
+    return np.count_nonzero(judged), np.count_nonzero(judged & behind)
+
+
+def learn_reference(depth, background, hits, near, far, far_frames, k, base, quadratic, span,
+                    absorb_frames, learn_frames, reveal_frames):
+    """Learn one depth image into the flat per-pixel state as :func:`learn` does, in numpy."""
+    nearer, behind, close = _relations(depth, background, k, base, quadratic)
+    first = ~np.isnan(depth) & np.isnan(background)
+    # At the scene's depth: a running mean over up to span readings.
+    count = np.minimum(hits + np.float32(1), span)
+    with np.errstate(invalid='ignore'):
+        step = np.where(close, (depth - background) / count, np.float32(0))
+    np.add(background, step, out=background, where=close)
+    np.copyto(hits, count, where=close)
+    # Never seen before: the first reading starts the pixel.
+    np.copyto(background, depth, where=first)
+    np.copyto(hits, np.float32(1), where=first)
+    # In front: held out until absorb_frames readings (a parked object).
+    near += nearer
+    near[close | behind] = 0
+    absorbed = nearer & (near >= absorb_frames)
+    np.copyto(background, depth, where=absorbed)
+    np.copyto(hits, np.float32(learn_frames), where=absorbed)
+    near[absorbed] = 0
+    # Behind, consistently: the scene uncovered.
+    with np.errstate(invalid='ignore'):
+        agrees = behind & (np.abs(depth - far) <= k * (base + quadratic * far * far))
+    restart = behind & ~agrees
+    np.copyto(far, depth, where=restart)
+    far_frames[restart] = 1
+    with np.errstate(invalid='ignore'):
+        step = (depth - far) / (far_frames + 1).astype(np.float32)
+    np.add(far, step, out=far, where=agrees)
+    far_frames += agrees
+    far_frames[close | nearer] = 0
+    revealed = far_frames >= reveal_frames
+    np.copyto(background, far, where=revealed)
+    # Trusted at once: the scene's far side, seen reveal_frames times.
+    np.copyto(hits, np.maximum(far_frames, learn_frames).astype(np.float32), where=revealed)
+    near[revealed] = 0
+    far_frames[revealed] = 0
+
+
 _NOISE = (np.float32(4.0), np.float32(0.002), np.float32(0.005))    # k, base, quadratic
 
 
@@ -133,7 +201,8 @@ def _learn_examples():
     return [(_depth(rng, state[0]), *state, *_NOISE, np.float32(30.0), 3, 10, 5)]
 
 
-_PASSES = (register_pass(judge, _judge_examples), register_pass(learn, _learn_examples))
+_PASSES = (register_pass(judge, _judge_examples, reference=judge_reference),
+           register_pass(learn, _learn_examples, reference=learn_reference))
 
 
 def compile_kernel():

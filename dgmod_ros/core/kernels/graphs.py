@@ -11,7 +11,8 @@ at every solve and for every channel (docs/solver.md has the cost).
 :func:`neighbour_square_sums` reads each frame once, row by
 contiguous row, and adds the frames in their order in float32, as the
 ``einsum`` did on the fused solver's window: there, the same sums bit for
-bit (``test/test_graphs.py``).
+bit as its numpy reference :func:`neighbour_square_sums_reference`
+(``test/test_compiled_passes.py``).
 numba's process-wide settings come with ``njit`` from
 :mod:`~dgmod_ros.core.numba_setup`; the pass is serial and ``nogil``.
 """
@@ -58,6 +59,24 @@ def neighbour_square_sums(frames):
     return right, down
 
 
-register_pass(neighbour_square_sums,
-              lambda: [(np.random.default_rng(0).uniform(0, 1, (m, 20, 30)).astype(np.float32),)
-                       for m in (1, 7)])
+def neighbour_square_sums_reference(frames):
+    """Return the sums of :func:`neighbour_square_sums` in numpy, a difference image per frame."""
+    frames = np.asarray(frames, dtype=np.float32)
+    across = np.diff(frames, axis=2)
+    along = np.diff(frames, axis=1)
+    right = np.zeros(across.shape[1:], dtype=np.float32)
+    down = np.zeros(along.shape[1:], dtype=np.float32)
+    for k in range(frames.shape[0]):            # float32 sums over the frames in their order
+        right += across[k] * across[k]
+        down += along[k] * along[k]
+    return right, down
+
+
+def _examples():
+    """Return windows of one and of seven frames, and the degenerate frame shapes."""
+    rng = np.random.default_rng(0)
+    return [(rng.uniform(0, 1, (m, rows, cols)).astype(np.float32),)
+            for m, rows, cols in ((1, 20, 30), (7, 20, 30), (11, 1, 9), (11, 9, 1), (11, 1, 1))]
+
+
+register_pass(neighbour_square_sums, _examples, reference=neighbour_square_sums_reference)

@@ -11,13 +11,15 @@ at ``scale`` 0.5, :func:`half_columns` does the same arithmetic in one pass
 over the frame and writes the columns directly: each value scaled and
 clipped as :func:`~dgmod_ros.core.preprocess.to_float_channels` does, and
 the area ``(((a + b) + c) + d) * 0.25`` in the order of OpenCV's
-integer-ratio area resize, so the columns are the same bit for bit
-(``test/test_per_frame_kernels.py``).
+integer-ratio area resize, so the columns are the same bit for bit: those
+of the general path's numpy and OpenCV steps, :func:`half_columns_reference`
+(``test/test_compiled_passes.py``, ``test/test_per_frame_kernels.py``).
 numba's process-wide settings come with ``njit`` from
 :mod:`~dgmod_ros.core.numba_setup`; the pass is serial and ``nogil``
 (the image callback's).
 """
 
+import cv2
 import numpy as np
 
 from ..numba_setup import njit, register_pass
@@ -59,22 +61,43 @@ def half_columns(image, scale, reverse):
     return out
 
 
+def half_columns_reference(image, scale, reverse):
+    """
+    Return :func:`half_columns`'s columns through the general path's steps.
+
+    As :func:`~dgmod_ros.core.preprocess.frame_columns` converts any frame:
+    to float32 times ``scale``, the first three channels (reversed with
+    ``reverse``) clipped to [0, 1], OpenCV's area resize to half size, then
+    one row per channel.
+    """
+    data = np.asarray(image).astype(np.float32) * np.float32(scale)
+    data = data[:, :, 2::-1] if reverse else data[:, :, :3]
+    data = np.clip(data, 0.0, 1.0, out=np.ascontiguousarray(data))
+    rows, cols = image.shape[0] // 2, image.shape[1] // 2
+    small = cv2.resize(data, (cols, rows), interpolation=cv2.INTER_AREA)
+    return np.ascontiguousarray(small.reshape(rows * cols, 3).T)
+
+
 def _examples():
     """
     Return frames of 8 and 16 bits, writeable and read-only, in both channel orders.
 
     Writeable and read-only frames both (a frame viewing a message's bytes
-    is read-only), since numba compiles each apart.
+    is read-only), since numba compiles each apart; and four-channel frames
+    with a smaller value range than the type's (values clipped to 1), which
+    compile nothing more.
     """
     rng = np.random.default_rng(0)
     examples = []
     for dtype in (np.uint8, np.uint16):
+        top = np.iinfo(dtype).max
         for writeable in (True, False):
-            top = np.iinfo(dtype).max
             frame = rng.integers(0, top, (24, 32, 3), endpoint=True).astype(dtype)
             frame.setflags(write=writeable)
             examples.extend((frame, 1.0 / top, reverse) for reverse in (False, True))
+        frame = rng.integers(0, top, (24, 32, 4), endpoint=True).astype(dtype)
+        examples.extend((frame, 1.0 / (0.8 * top), reverse) for reverse in (False, True))
     return examples
 
 
-register_pass(half_columns, _examples)
+register_pass(half_columns, _examples, reference=half_columns_reference)
