@@ -3,7 +3,7 @@
 """The robust dual-graph regularized separation model and its ADMM solver."""
 
 from dataclasses import dataclass, replace
-from numbers import Integral, Real
+from numbers import Integral
 
 import numpy as np
 
@@ -13,7 +13,8 @@ from .linalg import (drop_oldest, frames_major, gram_eigh, gram_matrix, mixing_f
                      relative_change, row_median, shrink, singular_value_map,
                      top_singular_value)
 from .runtime import limit_blas_threads
-from .validation import Interval, Options, validate_params
+from .validation import (Interval, NON_NEGATIVE, Options, POSITIVE, POSITIVE_INTEGER,
+                         validate_params)
 from .window_data import check_window_data
 
 
@@ -170,20 +171,18 @@ class DualGraphMOD:
     #: Whether the objective has the weighted nuclear norm (FRPCAG's has not).
     _nuclear_norm = True
 
-    _POSITIVE = [Interval(Real, 0, None, closed='neither')]
-    _NON_NEGATIVE = [Interval(Real, 0, None)]
-    _COUNT = [Interval(Integral, 1, None)]
     #: The parameters' constraints (:mod:`~dgmod_ros.core.validation`), in checking order.
     _parameter_constraints = {
-        'lambda2': _POSITIVE, 'rho1': _POSITIVE, 'rho2': _POSITIVE, 'tol': _POSITIVE,
-        'gamma1': _NON_NEGATIVE, 'gamma2': _NON_NEGATIVE, 'smoothing_sigma': _NON_NEGATIVE,
-        'lambda1': [None] + _NON_NEGATIVE,
-        'weight_scale': [None] + _POSITIVE, 'h_s': [None] + _POSITIVE,
-        'h_t': [None] + _POSITIVE, 'step_size': [None] + _POSITIVE,
+        'lambda2': POSITIVE, 'rho1': POSITIVE, 'rho2': POSITIVE, 'tol': POSITIVE,
+        'gamma1': NON_NEGATIVE, 'gamma2': NON_NEGATIVE, 'smoothing_sigma': NON_NEGATIVE,
+        'lambda1': (None, *NON_NEGATIVE),
+        'weight_scale': (None, *POSITIVE), 'h_s': (None, *POSITIVE),
+        'h_t': (None, *POSITIVE), 'step_size': (None, *POSITIVE),
         'l_step': [Options('gradient', 'exact')], 'svd': [Options('gram', 'full')],
         'engine': [Options('fused', 'numpy')],
         'patch_size': [Interval(Integral, 1, None, odd=True)],
-        'inner_iter': _COUNT, 'max_iter': _COUNT, 'temporal_neighbors': _COUNT,
+        'inner_iter': POSITIVE_INTEGER, 'max_iter': POSITIVE_INTEGER,
+        'temporal_neighbors': POSITIVE_INTEGER,
     }
 
     def __init__(self, lambda1=None, lambda2=0.5, gamma1=0.5, gamma2=0.5, rho1=20.0, rho2=20.0,

@@ -15,7 +15,7 @@ import numpy as np
 from scipy import ndimage
 import scipy.sparse as sp
 
-from .linalg import c_order, gram_matrix
+from .linalg import frames_major, gram_matrix
 
 
 def normalized_laplacian(adjacency):
@@ -138,7 +138,7 @@ def spatial_laplacian_bands(data, frame_shape, patch_size=3, h=None, smoothing_s
     n = n1 * n2
     # Frames-major (m, n1, n2): free for the fused solver's window, whose
     # memory is already in that order (linalg.frames_major).
-    frames = c_order(np.asarray(data, dtype=np.float32).T).reshape(m, n1, n2)
+    frames = frames_major(data).reshape(m, n1, n2)
     if smoothing_sigma > 0:
         frames = ndimage.gaussian_filter(frames, sigma=(0, smoothing_sigma, smoothing_sigma),
                                          mode='reflect')

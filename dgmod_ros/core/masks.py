@@ -22,13 +22,11 @@ optional morphological opening (speckle) and closing (holes) with an elliptic
 ``morph_size x morph_size`` kernel is applied.
 """
 
-from numbers import Integral, Real
-
 import cv2
 import numpy as np
 
 from .preprocess import to_uint8
-from .validation import Interval, Options, validate_params
+from .validation import NON_NEGATIVE, NON_NEGATIVE_INTEGER, Options, POSITIVE, validate_params
 
 # Enough samples for a stable median; larger windows are subsampled with a
 # fixed stride so that the estimate is deterministic.
@@ -65,10 +63,10 @@ class MaskRule:
     """
 
     _parameter_constraints = {
-        'threshold': [Options('auto'), Interval(Real, 0, None, closed='neither')],
-        'k': [Interval(Real, 0, None, closed='neither')],
-        'min_threshold': [Interval(Real, 0, None)],
-        'morph_size': [Interval(Integral, 0, None)],
+        'threshold': (Options('auto'), *POSITIVE),
+        'k': POSITIVE,
+        'min_threshold': NON_NEGATIVE,
+        'morph_size': NON_NEGATIVE_INTEGER,
     }
 
     def __init__(self, threshold='auto', k=5.0, min_threshold=0.1, morph_size=3):

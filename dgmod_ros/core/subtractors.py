@@ -2,8 +2,6 @@
 # Licensed under the Apache License, Version 2.0
 """OpenCV's per-frame subtractors: a streaming detector and a window method."""
 
-from numbers import Integral
-
 import cv2
 import numpy as np
 
@@ -11,8 +9,8 @@ from .masks import clean_mask
 from .preprocess import processing_shape, resize, to_float_channels, to_uint8
 from .streaming.contract import StreamingDetector
 from .streaming.results import FrameResult, SolverFailure
-from .streaming.settings import assign_validated, COLOR, COUNT, SCALE
-from .validation import Interval, Options, validate_params
+from .streaming.settings import assign_validated, COLOR, SCALE
+from .validation import NON_NEGATIVE_INTEGER, Options, POSITIVE_INTEGER, validate_params
 from .window_data import check_window_data
 
 _FACTORIES = {
@@ -59,7 +57,7 @@ class OpenCVSubtractor(StreamingDetector):
     """
 
     _parameter_constraints = {'kind': [Options(*_FACTORIES)], 'scale': SCALE, 'color': COLOR,
-                              'morph_size': [Interval(Integral, 0, None)], 'stride': COUNT}
+                              'morph_size': NON_NEGATIVE_INTEGER, 'stride': POSITIVE_INTEGER}
 
     def __init__(self, kind='mog2', scale=0.5, color='gray', morph_size=3, stride=10):
         self.kind = kind

@@ -107,6 +107,14 @@ class Options:
         return 'one of ' + ', '.join(repr(value) for value in self.values)
 
 
+#: The common ranges, shared by every class that declares constraints (tuples:
+#: a list of constraints is read, never changed; ``(None, *POSITIVE)`` adds None).
+POSITIVE = (Interval(Real, 0, None, closed='neither'),)
+NON_NEGATIVE = (Interval(Real, 0, None),)
+POSITIVE_INTEGER = (Interval(Integral, 1, None),)
+NON_NEGATIVE_INTEGER = (Interval(Integral, 0, None),)
+
+
 def satisfies(constraints, value, owner=None):
     """Return whether ``value`` satisfies one of ``constraints`` (None: the value None)."""
     return any(value is None if constraint is None

@@ -5,18 +5,17 @@
 import inspect
 from numbers import Integral, Real
 
-from ..validation import Interval, Options
+from ..validation import (Interval, NON_NEGATIVE, NON_NEGATIVE_INTEGER, Options, POSITIVE,
+                          POSITIVE_INTEGER)
 
 # Residuals the per-pixel noise level may come from (see window_solve.window_noise).
 NOISE_SOURCES = ('solve', 'projection', 'least_squares', 'max')
 
 #: The processing scale and the colour mode, shared by every streaming detector.
-SCALE = [Interval(Real, 0, 1, closed='right')]
-COLOR = [Options('gray', 'rgb')]
-COUNT = [Interval(Integral, 1, None)]
-NON_NEGATIVE = [Interval(Real, 0, None)]
+SCALE = (Interval(Real, 0, 1, closed='right'),)
+COLOR = (Options('gray', 'rgb'),)
 #: LBSP Hamming distances: 16 bits a channel, three channels at most.
-TEXTURE_BITS = [Interval(Integral, 0, 48)]
+TEXTURE_BITS = (Interval(Integral, 0, 48),)
 
 #: :class:`~dgmod_ros.core.streaming.sliding_window.SlidingWindowDetector`'s
 #: constraints (:mod:`~dgmod_ros.core.validation`), in the order they are checked.
@@ -28,20 +27,20 @@ WINDOW_CONSTRAINTS = {
     'motion_threshold': NON_NEGATIVE,
     'min_frames': [Interval(Integral, 2, 'window')],
     'global_change_fraction': [Interval(Real, 0, 1, closed='right')],
-    'basis_rank': COUNT,
-    'memory_spacing': COUNT,
-    'absorb_frames': COUNT,
+    'basis_rank': POSITIVE_INTEGER,
+    'memory_spacing': POSITIVE_INTEGER,
+    'absorb_frames': POSITIVE_INTEGER,
     'decision': [Options('adaptive', 'uniform', 'global')],
     'noise_source': [Options(*NOISE_SOURCES)],
-    'pixel_k': [Interval(Real, 0, None, closed='neither')],
+    'pixel_k': POSITIVE,
     'median_size': [Interval(Integral, 1, None, odd=True)],
-    'still_frames': [Interval(Integral, 0, None)],
+    'still_frames': NON_NEGATIVE_INTEGER,
     'mrf_beta': NON_NEGATIVE,
     'texture_bits': TEXTURE_BITS,
     'moving_texture_k': NON_NEGATIVE,
     'moving_texture_bits': TEXTURE_BITS,
-    'solve_lag': [Interval(Integral, 0, None)],
-    'solve_pixels': COUNT,
+    'solve_lag': NON_NEGATIVE_INTEGER,
+    'solve_pixels': POSITIVE_INTEGER,
     'solve_scale': SCALE,
 }
 
