@@ -3,13 +3,11 @@
 """The detector node in-process: frames in through a publisher, masks out."""
 
 import json
-from pathlib import Path
-import subprocess
-import sys
 
 from dgmod_ros.core.metrics import iou, psnr
 from dgmod_ros.core.synthetic import synthetic_scene
 from dgmod_ros.image_conversion import ENCODINGS
+from fresh_process import fresh_python
 import numpy as np
 import pytest
 from rclpy.parameter import Parameter
@@ -185,8 +183,6 @@ def test_the_node_loads_its_compiled_kernels_before_the_first_frame():
         '                      len(harness.masks)]))\n'
         'finally:\n'
         '    harness.close()\n')
-    done = subprocess.run([sys.executable, '-c', script], capture_output=True, text=True,
-                          cwd=str(Path(__file__).resolve().parents[1]), check=True)
-    before, after, masks = json.loads(done.stdout.strip().splitlines()[-1])
+    before, after, masks = json.loads(fresh_python(script).strip().splitlines()[-1])
     assert before == [0, 0, 0] and masks == 0
     assert all(count > 0 for count in after)

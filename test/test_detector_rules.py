@@ -2,14 +2,12 @@
 # Licensed under the Apache License, Version 2.0
 """The node's per-frame rules without ROS: the encoding-change restart and the solve schedule."""
 
-from pathlib import Path
-import subprocess
-import sys
 from types import SimpleNamespace
 
 from dgmod_ros import config
 from dgmod_ros.core.synthetic import synthetic_scene
 from dgmod_ros.detector_rules import EncodingWatch, mask_frame, solve_job
+from fresh_process import fresh_python
 import pytest
 
 
@@ -99,6 +97,4 @@ def test_the_nodes_rules_import_no_ros():
               'import dgmod_ros.solve_worker, dgmod_ros.stats\n'
               'print(sorted(m for m in sys.modules if m.split(".")[0] in\n'
               '             ("rclpy", "sensor_msgs", "diagnostic_msgs", "rcl_interfaces")))\n')
-    done = subprocess.run([sys.executable, '-c', script], capture_output=True, text=True,
-                          cwd=str(Path(__file__).resolve().parents[1]), check=True)
-    assert done.stdout.strip() == '[]'
+    assert fresh_python(script).strip() == '[]'

@@ -69,3 +69,23 @@ def test_sampled_fit_projects_every_pixel_as_the_full_fit_does():
     # person's 0.4 and more.
     assert np.abs(sampled - full).max() < 0.005
     assert np.abs(sampled[:, 4000:5200] - 0.95).min() > 0.2
+
+
+def test_a_person_covering_much_of_the_view_is_left_out_of_the_starting_fit():
+    # A dark person over 45 % of the pixels pulls the least-squares start
+    # towards them, and three sweeps from there leave the whole frame off
+    # its background; the previous frame's foreground left out of the fit,
+    # it is the frame's gain again.
+    basis, frame, _ = _frame_and_basis(2)
+    person = np.zeros(frame.shape[1], dtype=bool)
+    person[600:1950] = True
+    frame[:, person] = 0.02
+    outside = ~person
+    pulled = np.abs(robust_projection(basis, frame) - frame)[:, outside]
+    fitted = robust_projection(basis, frame, left_out=person)
+    assert np.abs(fitted - frame)[:, outside].max() < 0.05
+    assert pulled.max() > 2 * np.abs(fitted - frame)[:, outside].max()
+    # Too few pixels left to fix a fit: the start of the whole frame.
+    everything = np.ones_like(person)
+    assert np.array_equal(robust_projection(basis, frame, left_out=everything),
+                          robust_projection(basis, frame))

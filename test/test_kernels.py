@@ -17,6 +17,7 @@ from dgmod_ros.core.kernels import dgmod as kernels
 from dgmod_ros.core.linalg import c_order, frames_major, gram_matrix
 from dgmod_ros.core.runtime import limit_blas_threads
 from dgmod_ros.core.synthetic import synthetic_scene
+from fresh_process import fresh_python
 import numba
 import numpy as np
 import pytest
@@ -233,9 +234,7 @@ def test_threading_layer_survives_numba_imported_first(tmp_path):
         'one_more(1)\n'
         'print(numba.config.THREADING_LAYER)\n')
     env = dict(os.environ, XDG_CACHE_HOME=str(tmp_path))
-    done = subprocess.run([sys.executable, '-c', script], capture_output=True, text=True,
-                          env=env, cwd=str(Path(__file__).resolve().parents[1]), check=True)
-    assert done.stdout.strip() == 'threadsafe'
+    assert fresh_python(script, env).strip() == 'threadsafe'
 
 
 # Run in a fresh interpreter: compile_all, then the detector on read-only

@@ -66,7 +66,7 @@ def irls(coef, normal_equations, solve):
     return coef
 
 
-def robust_projection(basis, columns, fit_pixels=None, fit_basis=None):
+def robust_projection(basis, columns, fit_pixels=None, fit_basis=None, left_out=None):
     """
     l1-fit each channel's column onto its basis by IRLS; return the fitted columns.
 
@@ -86,9 +86,16 @@ def robust_projection(basis, columns, fit_pixels=None, fit_basis=None):
         Most pixels the sweeps weigh; None: ``FIT_PIXELS``.
     fit_basis : ndarray or None
         ``sampled_basis(basis, fit_pixels)`` where the caller keeps it; None forms it.
+    left_out : ndarray (n,) bool or None
+        Pixels the fit leaves out (the previous frame's foreground), unless
+        fewer than a tenth of the sample would remain: an l1 fit breaks
+        down once a person covers about half of the view (its start sooner:
+        least squares over a person covering 40 % is pulled towards them),
+        and the whole frame then reads as changed. None: every pixel.
 
     """
-    return _robust_projection(basis, columns, fit_pixels, fit_basis, weighted_normal_equations)
+    return _robust_projection(basis, columns, fit_pixels, fit_basis, weighted_normal_equations,
+                              left_out)
 
 
 def robust_projection_reference(basis, columns, fit_pixels=None):
@@ -97,7 +104,7 @@ def robust_projection_reference(basis, columns, fit_pixels=None):
                               weighted_normal_equations_reference)
 
 
-def _robust_projection(basis, columns, fit_pixels, fit_basis, equations):
+def _robust_projection(basis, columns, fit_pixels, fit_basis, equations, left_out=None):
     basis = np.ascontiguousarray(basis, dtype=np.float32)
     columns = np.ascontiguousarray(columns, dtype=np.float32)
     channels, n, rank = basis.shape
@@ -108,6 +115,7 @@ def _robust_projection(basis, columns, fit_pixels, fit_basis, equations):
         fit_basis = sampled_basis(basis, fit_pixels)
     fit_columns = columns if step == 1 else np.ascontiguousarray(columns[:, ::step])
 
+    # The sweeps read fit_basis and fit_columns when called: after the kept pixels' choice below.
     def normal_equations(coef):
         equations(fit_basis, fit_columns, coef, _IRLS_FLOOR, gram, rhs)
         return gram, rhs
@@ -116,7 +124,17 @@ def _robust_projection(basis, columns, fit_pixels, fit_basis, equations):
         return np.stack([np.linalg.lstsq(gram[channel], rhs[channel], rcond=None)[0]
                          for channel in range(channels)])
 
-    coef = np.matmul(columns[:, None, :], basis)[:, 0, :].astype(np.float64)
+    kept = None if left_out is None else ~np.asarray(left_out, dtype=bool)[::step]
+    # Too few pixels left to fix the fit: the whole frame's.
+    if kept is not None and np.count_nonzero(kept) >= max(16, kept.size // 10):
+        fit_basis = np.ascontiguousarray(fit_basis[:, kept])
+        fit_columns = np.ascontiguousarray(fit_columns[:, kept])
+        # Least squares over the kept pixels, where the basis is not orthonormal.
+        start = np.matmul(fit_columns[:, None, :], fit_basis)[:, 0, :].astype(np.float64)
+        coef = solve(np.matmul(fit_basis.transpose(0, 2, 1), fit_basis).astype(np.float64),
+                     start)
+    else:
+        coef = np.matmul(columns[:, None, :], basis)[:, 0, :].astype(np.float64)
     coef = irls(coef, normal_equations, solve)
     return np.matmul(basis, coef.astype(np.float32)[:, :, None])[:, :, 0]
 

@@ -343,6 +343,11 @@ class SlidingWindowDetector(StreamingDetector):
         self.heal_ = None
         self.healed_ = None
         self.uncovered_age_ = None
+        self.previous_foreground_ = None
+        self.still_value_ = None         # (C, n) each pixel's newest settled value
+        self.still_known_ = None         # (n,) bool: the pixel has settled once
+        self.moving_ = None              # (n,) bool: moving now, settled before
+        self.held_still_ = None
 
     def reset(self):
         """Forget every buffered frame and the background model."""
@@ -398,15 +403,48 @@ class SlidingWindowDetector(StreamingDetector):
             return background, model.threshold
         if model.noise is None:             # solved under the global rule
             return background, model.threshold / self.mask_rule_.k
-        return background, model.noise
+        return self._unpulled(model, columns, background), model.noise
+
+    def _unpulled(self, model, columns, background):
+        """
+        Return ``background``, or the fit without the previous frame's foreground if that fits.
+
+        An l1 fit breaks down once a person covers about half of the view:
+        the whole frame then reads as changed, and the scene-change rule
+        would restart the window from frames of the person, whose background
+        is the person from then on. Where the whole frame's fit reads as a
+        scene change (over ``global_change_fraction`` of the pixels off it by
+        ``pixel_k`` noise levels), the fit is tried again without the pixels
+        the previous frame called foreground; if that one does not read as a
+        scene change, a large person pulled the first. Only then, not in
+        every fit: a region wrongly called foreground (a corner a change of
+        light left as it was), left out of every fit, keeps itself foreground.
+        """
+        if self.previous_foreground_ is None:
+            return background
+        bound = self.pixel_k * np.asarray(model.noise, dtype=np.float32)
+
+        def changed_share(fitted):
+            return np.count_nonzero(np.abs(columns - fitted).max(axis=0) > bound) / bound.size
+
+        if changed_share(background) <= self.global_change_fraction:
+            return background
+        unpulled = robust_projection(model.basis, columns, fit_basis=model.fit_basis,
+                                     left_out=self.previous_foreground_)
+        return unpulled if changed_share(unpulled) <= self.global_change_fraction else background
 
     def _finish(self, pending):
         # The stages in the order a frame passes them (the package docstring's list).
         result, columns = pending
         background, level = self._background(columns)
-        foreground, changed = self._decide(result, columns, background, level)
+        earlier = self.recent_[0][1] if len(self.recent_) == self.recent_.maxlen else None
+        # Each pixel's change against the earlier frame, for the rules that ask it of pixels.
+        change = None if earlier is None else np.abs(columns - earlier).max(axis=0)
+        foreground, changed = self._decide(result, columns, background, level, earlier, change)
+        self._note_still(columns, change, level)
         result.buffered = self._admit(columns, background, foreground, result.frame_id,
                                       result.magnitude, level)
+        self.previous_foreground_ = foreground.ravel() > 0
         self.recent_.append((result.frame_id, columns))
         result.model_ready = self.background_model_ is not None
         result.new_background = self.background_pending_
@@ -416,7 +454,7 @@ class SlidingWindowDetector(StreamingDetector):
             self._restart_from_newest(SceneChangeWatch.FRAMES)
         return result
 
-    def _decide(self, result, columns, background, level):
+    def _decide(self, result, columns, background, level, earlier, change):
         """
         Set ``result``'s magnitude and mask; return the processing-size foreground and the changes.
 
@@ -430,7 +468,6 @@ class SlidingWindowDetector(StreamingDetector):
             foreground = np.where(result.magnitude > level, np.uint8(255), np.uint8(0))
             return foreground, result.mask
         model = self.background_model_
-        earlier = self.recent_[0][1] if len(self.recent_) == self.recent_.maxlen else None
         foreground, result.magnitude = adaptive_mask(
             columns, background, level, self.pixel_k, self.shape_, self.median_size,
             self.mrf_beta, self.lighting_, model.chroma_noise if model is not None else None,
@@ -441,18 +478,15 @@ class SlidingWindowDetector(StreamingDetector):
         changed = result.magnitude.ravel() > self.pixel_k * level
         if ((self.ghost_test or self.still_frames) and model is not None
                 and earlier is not None):
-            self._blob_rules(foreground, columns, background, level, earlier)
+            self._blob_rules(foreground, columns, background, level, earlier, change)
         result.mask = to_input_size(foreground, self.input_shape_)
         return foreground, changed
 
-    def _blob_rules(self, foreground, columns, background, level, earlier):
+    def _blob_rules(self, foreground, columns, background, level, earlier, change):
         """Drop, in place, the ghost blobs and the blobs held still from ``foreground``."""
         # One labelling for both tests: the ghost test drops whole blobs.
         blobs = BlobMotion(foreground, columns, earlier, level)
         before = foreground > 0
-        # Each pixel's change against the earlier frame, for the rules
-        # below that ask it of single pixels.
-        change = np.abs(columns - earlier).max(axis=0)
         moved = moved_inside(foreground, self.foreground_age_, change, level, self.pixel_k,
                              _GHOST_LAG)
         self.entered_ = moved if self.entered_ is None else moved | self.entered_
@@ -497,6 +531,35 @@ class SlidingWindowDetector(StreamingDetector):
         pixels |= uncovered
         values[:, uncovered] = columns[:, uncovered]
 
+    def _note_still(self, columns, change, level):
+        """
+        Keep each pixel's newest settled value and mark the pixels moving now.
+
+        A pixel holds still when its ``change`` against the frame
+        ``_GHOST_LAG`` frames before is within ``pixel_k / 2`` noise levels
+        (the still test of the blob rules); it has settled once it has held
+        still for ``_GHOST_LAG`` frames in a row (the same value over twice
+        the lag: a walker's plain trousers hold still for a frame or two, a
+        place behind them that is uncovered settles). A pixel moving now
+        (not holding still) that has settled before is admitted to the
+        window with its settled value (:meth:`_admit`): motion is no
+        evidence of the background, the way LaBGen picks, per pixel, the
+        samples with the least motion. A pixel that never settled (leaves
+        that never rest) is admitted as it is.
+        """
+        if change is None or self.decision == 'global':
+            return
+        still = change <= self.pixel_k / 2 * np.asarray(level, dtype=np.float32)
+        self.held_still_ = consecutive_frames(self.held_still_, still)
+        settled = self.held_still_ >= _GHOST_LAG
+        if self.still_value_ is None:
+            self.still_value_ = columns.copy()
+            self.still_known_ = settled.copy()
+        else:
+            np.copyto(self.still_value_, columns, where=settled[None, :])
+            self.still_known_ |= settled
+        self.moving_ = ~still & self.still_known_
+
     def _admit(self, columns, background, foreground, frame_id, distance, level):
         """Put the frame into the window if due (conditionally); return whether it went in."""
         self.foreground_age_ = consecutive_frames(self.foreground_age_, foreground > 0)
@@ -509,6 +572,11 @@ class SlidingWindowDetector(StreamingDetector):
                 or self.buffer_.is_motionless(columns, self.motion_threshold)):
             return False
         observed = None
+        frame = columns
+        if self.moving_ is not None:
+            # What moves now is no evidence of the background: the window
+            # takes the pixel's newest settled value there instead.
+            columns = np.where(self.moving_[None, :], self.still_value_, columns)
         if self.conditional_update:
             # While the window fills, every frame goes in as it is: the first
             # solves must separate whatever moves in the first frames, and a
@@ -518,7 +586,9 @@ class SlidingWindowDetector(StreamingDetector):
                        and len(self.buffer_) >= self.buffer_.capacity)
             held = foreground
             if replace and self.hold_changes and self.decision != 'global':
-                held = self._held(columns, foreground, distance, level)
+                # The frame's own changes, not the settled values': what
+                # changes is held out of the window, settled or not.
+                held = self._held(frame, foreground, distance, level)
             # Dilated: a silhouette's border is foreground below the threshold.
             grown = cv2.dilate(held, _BORDER_KERNEL).ravel() > 0
             columns, observed = conditional_columns(columns, background, grown,
