@@ -8,11 +8,13 @@ with the package defaults, changed by ``--set name=value``, over every frame
 of each dataset (the seven dev sequences by default), scores the temporal ROI
 CDnet-style, writes the masks (to ``--masks DIR`` or a scratch folder) and
 runs ``../shared/tools/object_recall.py`` on them (person recall, false blobs
-per frame). ``--scenarios DIR`` adds the scenario suite
-(:mod:`dgmod_ros.scenarios`), written to ``DIR`` first where it is not there
-yet; ``--scenarios-only`` scores only it. ``--max-frames N`` feeds each
-dataset up to its first scored frame plus ``N`` frames (a cheap run). Prints
-one line per dataset and the mean F.
+per frame); the published background is scored where people were and the
+place behind them has been seen
+(:class:`~dgmod_ros.core.metrics.BackgroundPersonCounts`). ``--scenarios
+DIR`` adds the scenario suite (:mod:`dgmod_ros.scenarios`), written to
+``DIR`` first where it is not there yet; ``--scenarios-only`` scores only it.
+``--max-frames N`` feeds each dataset up to its first scored frame plus ``N``
+frames (a cheap run). Prints one line per dataset and the mean F.
 
 Usage::
 
@@ -33,7 +35,7 @@ import time
 
 import cv2
 from dgmod_ros import config
-from dgmod_ros.core.metrics import ConfusionCounts
+from dgmod_ros.core.metrics import BackgroundPersonCounts, ConfusionCounts
 from dgmod_ros.evaluation import load_dataset
 from dgmod_ros.inputs import read_frames
 from dgmod_ros.sequence import results
@@ -83,18 +85,26 @@ def score_dataset(path, values, mode, masks_dir=None, max_frames=None):
         out.mkdir(parents=True, exist_ok=True)
         for stale in out.glob('bin*.png'):
             stale.unlink()
-    for frame, mask, _, _ in results(frames, values, mode):
+    behind = BackgroundPersonCounts()
+    for frame, mask, background, _ in results(frames, values, mode):
+        if background is not None:      # published before the scored frames too
+            behind.background = background
         inside = dataset.first <= frame.index <= last
         if inside:
             truth = cv2.imread(str(dataset.truths[frame.index]), cv2.IMREAD_GRAYSCALE)
             counts.add(mask, truth, dataset.roi)
+            image = frame.image[..., ::-1] if frame.channel_order == 'bgr' else frame.image
+            behind.add(frame.index, image, truth, roi=None if dataset.roi is None
+                       else dataset.roi > 0)
         if out is not None and inside:
             cv2.imwrite(str(out / mask_name(dataset, frame.index)), mask)
     seconds = time.perf_counter() - started
     row = {'dataset': dataset.name, 'precision': counts.precision, 'recall': counts.recall,
            'fmeasure': counts.fmeasure, 'frames': len(frames),
            'scored_frames': last - dataset.first + 1,
-           'ms_per_frame': 1000 * seconds / len(frames)}
+           'ms_per_frame': 1000 * seconds / len(frames),
+           'background_wrong_behind': behind.wrong_share,
+           'background_wrong_behind_late': behind.late_wrong_share}
     if out is not None and RECALL_TOOL.is_file():
         report = subprocess.run([sys.executable, str(RECALL_TOOL), str(dataset.path), str(out),
                                  '--json'], capture_output=True, text=True, check=True)
@@ -122,6 +132,9 @@ def format_row(row):
     if 'person_recall' in row:
         extra = (f"  person recall {row['person_recall']:.3f}  false blobs/frame "
                  f"{row['false_blobs_per_frame']:.2f}")
+    late = row['background_wrong_behind_late']
+    extra += f"  background wrong behind people {row['background_wrong_behind']:.3f}"
+    extra += '' if late is None else f' (after 60 s {late:.3f})'
     return (f"{row['dataset']:20s} Pr {row['precision']:.3f} Re {row['recall']:.3f} "
             f"F {row['fmeasure']:.3f}  {row['ms_per_frame']:.1f} ms/frame{extra}")
 

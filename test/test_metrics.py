@@ -1,6 +1,7 @@
 # Copyright 2026 dgmod_ros authors
 # Licensed under the Apache License, Version 2.0
-from dgmod_ros.core.metrics import ConfusionCounts, iou, psnr, relative_error
+from dgmod_ros.core.metrics import (BackgroundPersonCounts, ConfusionCounts, iou, psnr,
+                                    relative_error)
 import numpy as np
 import pytest
 
@@ -52,3 +53,29 @@ def test_iou():
     b = np.array([[0, 1, 1, 0]])
     assert iou(a, b) == pytest.approx(1 / 3)
     assert iou(np.zeros((2, 2)), np.zeros((2, 2))) == 1.0
+
+
+def test_background_person_counts_score_the_places_a_person_uncovered():
+    wall = np.full((40, 60, 3), 128, np.uint8)
+    person = np.zeros((40, 60), np.uint8)
+    person[10:30, 20:30] = 255
+    clean = wall.astype(np.float32) / 255.0
+    ghost = clean.copy()
+    ghost[10:30, 20:30] = 0.1                       # the person left in the background
+    edge = clean.copy()
+    edge[:, 45] = 0.9                               # one blurred edge: no person
+    away = np.zeros_like(person)
+    # The opening by a 5 x 5 disc takes the ghost's corners: 0.96 of it.
+    for background, expected in ((clean, 0.0), (ghost, 0.96), (edge, 0.0)):
+        counts = BackgroundPersonCounts(late_frame=2)
+        counts.add(0, wall, person, background)     # the person in front: nothing seen behind
+        assert counts.seen == 0 and counts.late_wrong_share is None
+        counts.add(1, wall, away)
+        counts.add(2, wall, away)                   # the place behind seen, the newest background
+        assert counts.seen == 2 * 200
+        assert counts.wrong_share == pytest.approx(expected, abs=0.02)
+        assert counts.late_wrong_share == pytest.approx(expected, abs=0.02)
+    half = BackgroundPersonCounts()
+    half.add(0, wall, person, ghost)
+    half.add(1, wall, np.where(np.arange(60) < 25, 0, person).astype(np.uint8))
+    assert half.seen == 100 and half.wrong_share > 0.9      # 5 columns uncovered, 5 wide
