@@ -59,7 +59,7 @@ GRID = {
     'pixel_k': (4.5, 6.0, 7.5),
     'still_frames': (15, 25, 40),
     'memory_spacing': (5, 10, 20),
-    'absorb_frames': (150, 300, 600),
+    'absorb_frames': (2700, 5400, 10800),
     'moving_texture_k': (2.0, 3.0, 4.0),
     'texture_bits': (6, 8, 10),
     'mrf_beta': (1.0, 2.0, 3.0),
