@@ -443,7 +443,7 @@ class SlidingWindowDetector(StreamingDetector):
         foreground, changed = self._decide(result, columns, background, level, earlier, change)
         self._note_still(columns, change, level)
         result.buffered = self._admit(columns, background, foreground, result.frame_id,
-                                      result.magnitude, level)
+                                      result.magnitude, level, change)
         self.previous_foreground_ = foreground.ravel() > 0
         self.recent_.append((result.frame_id, columns))
         result.model_ready = self.background_model_ is not None
@@ -554,14 +554,18 @@ class SlidingWindowDetector(StreamingDetector):
         settled = self.held_still_ >= _GHOST_LAG
         if self.still_value_ is None:
             self.still_value_ = columns.copy()
-            self.still_known_ = settled.copy()
-        else:
-            np.copyto(self.still_value_, columns, where=settled[None, :])
-            self.still_known_ |= settled
+            self.still_known_ = np.zeros_like(settled)
+        np.copyto(self.still_value_, columns, where=settled[None, :])
+        self.still_known_ |= settled
         self.moving_ = ~still & self.still_known_
 
-    def _admit(self, columns, background, foreground, frame_id, distance, level):
-        """Put the frame into the window if due (conditionally); return whether it went in."""
+    def _admit(self, columns, background, foreground, frame_id, distance, level, change):
+        """
+        Put the frame into the window if due (conditionally); return whether it went in.
+
+        ``change`` (n,) is each pixel's change against the frame
+        ``_GHOST_LAG`` frames before (None while there is none).
+        """
         self.foreground_age_ = consecutive_frames(self.foreground_age_, foreground > 0)
         if self.entered_ is not None:
             self.entered_ = self.entered_ & (self.foreground_age_ > 0)
@@ -572,7 +576,6 @@ class SlidingWindowDetector(StreamingDetector):
                 or self.buffer_.is_motionless(columns, self.motion_threshold)):
             return False
         observed = None
-        frame = columns
         if self.moving_ is not None:
             # What moves now is no evidence of the background: the window
             # takes the pixel's newest settled value there instead.
@@ -586,9 +589,7 @@ class SlidingWindowDetector(StreamingDetector):
                        and len(self.buffer_) >= self.buffer_.capacity)
             held = foreground
             if replace and self.hold_changes and self.decision != 'global':
-                # The frame's own changes, not the settled values': what
-                # changes is held out of the window, settled or not.
-                held = self._held(frame, foreground, distance, level)
+                held = self._held(foreground, distance, level, change)
             # Dilated: a silhouette's border is foreground below the threshold.
             grown = cv2.dilate(held, _BORDER_KERNEL).ravel() > 0
             columns, observed = conditional_columns(columns, background, grown,
@@ -604,12 +605,11 @@ class SlidingWindowDetector(StreamingDetector):
         self.buffer_.append(columns, frame_id, observed)
         return True
 
-    def _held(self, columns, foreground, distance, level):
+    def _held(self, foreground, distance, level, change):
         """Return the frame's pixels (rows, cols) uint8 that the conditional update keeps out."""
-        if len(self.recent_) < self.recent_.maxlen:
+        if change is None:
             changing = np.zeros_like(self.away_)
         else:
-            change = np.abs(columns - self.recent_[0][1]).max(axis=0)
             changing = change > self.pixel_k / 2 * level
         held = held_pixels(foreground, self.away_, changing, self.away_age_,
                            self.still_frames)
