@@ -9,6 +9,7 @@ from dgmod_ros.core.streaming.blobs import BlobMotion
 from dgmod_ros.core.streaming.coherence import mean_field_mask
 from dgmod_ros.core.streaming.decision import adaptive_mask, moving_texture_k
 from dgmod_ros.core.streaming.fast_path import projection_residual, robust_projection
+from dgmod_ros.core.streaming.ghost import ghost_parts
 from dgmod_ros.core.streaming.held_foreground import (came_in, consecutive_frames, moved_inside,
                                                       still_blob_pixels)
 from dgmod_ros.core.streaming.noise_levels import pixel_noise, warmup_noise
@@ -224,6 +225,95 @@ def test_a_pacer_from_the_first_frame_leaves_no_trail_in_the_background():
                          .astype(np.uint8))
     off = np.abs(detector.background_image().mean(axis=2) - wall)[30:80, 40:94]
     assert (off > 0.1).mean() < 0.05
+
+
+def _joined_ghost(frame_shows_person):
+    """
+    Return ``(mask, frame, background, still)`` of a ghost joined to a person leaving it.
+
+    The background holds a dark silhouette at columns 16-29 (the departed),
+    the frame a dark person at columns 30-39 who moves and, where he stood,
+    the plain place (or, ``frame_shows_person``, the person still standing
+    there and the background plain: a person who stopped next to one who
+    walks). One blob covers both.
+    """
+    rows, cols = 40, 60
+    place = np.full((rows, cols), 0.6, np.float32)
+    standing, walking = np.s_[5:35, 16:30], np.s_[5:35, 30:40]
+    frame, background = place.copy(), place.copy()
+    (frame if frame_shows_person else background)[standing] = 0.1
+    frame[walking] = 0.1
+    mask = np.zeros((rows, cols), np.uint8)
+    mask[5:35, 16:40] = 255
+    still = np.ones((rows, cols), bool)
+    still[walking] = False
+    as_columns = (lambda grey: np.repeat(grey.reshape(1, -1), 3, axis=0))
+    return mask, as_columns(frame), as_columns(background), still.ravel()
+
+
+def test_ghost_parts_drops_the_still_part_whose_outline_only_the_background_shows():
+    mask, frame, background, still = _joined_ghost(frame_shows_person=False)
+    ghosts = ghost_parts(mask, frame, background, still, 0.01, 6.0)
+    assert ghosts[5:35, 16:30].all()
+    assert not ghosts[5:35, 30:40].any() and not ghosts[mask == 0].any()
+
+
+def test_ghost_parts_keep_a_person_standing_still_beside_one_who_walks():
+    mask, frame, background, still = _joined_ghost(frame_shows_person=True)
+    assert not ghost_parts(mask, frame, background, still, 0.01, 6.0).any()
+
+
+def test_ghost_parts_keep_a_still_person_over_texture_the_outline_crosses():
+    # The place behind is textured (edges every way in the background), the
+    # person on it plain and as bright as the place on average: along the
+    # outline the background's edges cross it and the frame's are as strong.
+    rng = np.random.default_rng(2)
+    rows, cols = 40, 60
+    background = rng.uniform(0.3, 0.9, (rows, cols)).astype(np.float32)
+    frame = background.copy()
+    frame[8:32, 20:40] = 0.6
+    mask = np.zeros((rows, cols), np.uint8)
+    mask[8:32, 20:40] = 255
+    columns = (lambda grey: np.repeat(grey.reshape(1, -1), 3, axis=0))
+    still = np.ones(rows * cols, bool)
+    assert not ghost_parts(mask, columns(frame), columns(background), still, 0.01, 6.0).any()
+
+
+def test_ghost_parts_of_an_empty_or_moving_mask_is_empty():
+    mask, frame, background, still = _joined_ghost(frame_shows_person=False)
+    assert not ghost_parts(np.zeros_like(mask), frame, background, still, 0.01, 6.0).any()
+    assert not ghost_parts(mask, frame, background, np.zeros_like(still), 0.01, 6.0).any()
+
+
+def _stands_then_leaves(frames=110, stand=60):
+    """Yield a textured scene, a textured body in it from frame 0 leaving at 1 pixel a frame."""
+    rng = np.random.default_rng(7)
+    wall = textured_background((96, 128), rng)
+    wall = np.repeat(wall[..., None], 3, axis=2) * np.array([1.0, 0.95, 0.9], np.float32)
+    body = rng.uniform(0.0, 0.3, (60, 24, 3)).astype(np.float32)
+    for index in range(frames):
+        image = wall + rng.normal(0, 0.004, wall.shape).astype(np.float32)
+        left = 30 + max(index - stand, 0)
+        image[20:80, left:left + 24] = body
+        yield np.clip(image, 0, 1), left
+
+
+def test_a_ghost_joined_to_what_leaves_it_clears_before_they_part():
+    # The body is the window's background from the first frame; walking off,
+    # it stays one blob with the place it uncovers until it is a body width
+    # (24 frames) away. The still part of that blob, whose outline only the
+    # background shows, is dropped. Measured over shifts 12-23: the place
+    # uncovered 8 or more frames before is 0.00 foreground (1.00 without the
+    # part test), the body 1.00.
+    detector = SlidingWindowDetector()
+    ghost, body = [], []
+    for image, left in _stands_then_leaves(frames=84):
+        mask = detector.process(image)[0].mask > 0
+        if left - 30 >= 12:
+            ghost.append(mask[22:78, 30:left - 8].mean())
+            body.append(mask[22:78, left + 2:left + 22].mean())
+    assert max(ghost) < 0.2
+    assert min(body) > 0.9
 
 
 def test_healed_starts_start_the_healed_pixels_from_the_data():

@@ -146,7 +146,7 @@ def conditional_columns(columns, background, foreground, foreground_age, absorb_
     Return the columns to admit and their observed pixels (conditional update).
 
     The observed pixels are those the noise levels count
-    (:func:`~dgmod_ros.core.streaming.foreground.pixel_noise`): the frame's
+    (:func:`~dgmod_ros.core.streaming.noise_levels.pixel_noise`): the frame's
     own pixels where its mask called it background.
 
     Parameters

@@ -20,7 +20,7 @@ light when all the enabled cues agree
 
 - chromaticity: ``c`` within ``k`` times the pixel's own chromaticity noise
   level (:func:`chroma_noise`: read from the window's ``D`` and ``L`` the way
-  :func:`~dgmod_ros.core.streaming.foreground.pixel_noise` reads the level of
+  :func:`~dgmod_ros.core.streaming.noise_levels.pixel_noise` reads the level of
   the channel-wise difference);
 - texture: the LBSP descriptor distance to the background
   (:mod:`~dgmod_ros.core.streaming.kernels.texture`) at most ``texture_bits``;
@@ -56,13 +56,13 @@ def chroma_noise(data, residual, shape, observed=None, uniform=False, sample=Non
         Processing shape.
     observed : ndarray (n, m) bool or None
         Entries the level counts, as for
-        :func:`~dgmod_ros.core.streaming.foreground.pixel_noise` (with
+        :func:`~dgmod_ros.core.streaming.noise_levels.pixel_noise` (with
         ``sample``: (k, m)); None: all.
     uniform : bool
         Give every pixel the typical level.
     sample : PixelSample or None
         Read the levels at ``sample``'s pixels and upsample them
-        (:func:`~dgmod_ros.core.streaming.foreground.pixel_noise`); None: every pixel.
+        (:func:`~dgmod_ros.core.streaming.noise_levels.pixel_noise`); None: every pixel.
 
     """
     chroma = reference_unless(window_chroma, window_chroma_reference, data, residual)

@@ -18,7 +18,7 @@ from .buffer import SceneChangeWatch
 from .contract import StreamingDetector
 from .decision import adaptive_mask
 from .fast_path import robust_projection
-from .ghost import ghost_labels
+from .ghost import ghost_labels, ghost_parts
 from .held_foreground import consecutive_frames, moved_inside, still_blob_pixels
 from .kernels.warmup_background import entry_medians
 from .noise_levels import warmup_noise
@@ -49,7 +49,7 @@ class SlidingWindowDetector(StreamingDetector):
     background subspace of the last window solve
     (:mod:`~dgmod_ros.core.streaming.fast_path`) and decides each pixel
     against its own noise level
-    (:mod:`~dgmod_ros.core.streaming.foreground`; ``decision='global'``: the
+    (:mod:`~dgmod_ros.core.streaming.decision`; ``decision='global'``: the
     :class:`~dgmod_ros.core.masks.MaskRule`). The frame then enters the window
     if due (:mod:`~dgmod_ros.core.streaming.background_memory`: every
     ``memory_spacing`` frames, its foreground replaced by the background).
@@ -143,8 +143,11 @@ class SlidingWindowDetector(StreamingDetector):
     ghost_test : bool, default=True
         Drop still blobs whose outline is an edge of the background rather
         than of the frame (something in the window's frames has left; see
-        :func:`~dgmod_ros.core.streaming.foreground.ghost_blobs`); their
-        pixels enter the window as they are, which heals the background.
+        :func:`~dgmod_ros.core.streaming.ghost.ghost_blobs`), and the still
+        parts of blobs along most of whose outline the background crosses an
+        edge that the frame does not (a ghost joined to what is leaving it:
+        :func:`~dgmod_ros.core.streaming.ghost.ghost_parts`); their pixels
+        enter the window as they are, which heals the background.
     still_frames : int, default=25
         Drop pixels that have been in a still blob (at most 1 % of its pixels
         changed by more than ``pixel_k / 2`` noise levels against the frame
@@ -176,7 +179,7 @@ class SlidingWindowDetector(StreamingDetector):
         least ``moving_texture_bits`` bits and that changed against the frame
         5 frames before is foreground from this multiple of its noise level
         instead of ``pixel_k`` ('adaptive', 'uniform'; see
-        :func:`~dgmod_ros.core.streaming.foreground.moving_texture_k`); 0
+        :func:`~dgmod_ros.core.streaming.decision.moving_texture_k`); 0
         disables.
     moving_texture_bits : int, default=16
         Fewest differing LBSP bits of a changed texture.
@@ -493,6 +496,10 @@ class SlidingWindowDetector(StreamingDetector):
         if self.ghost_test:
             blobs.drop(ghost_labels(blobs, foreground, columns, background, self.pixel_k),
                        foreground)
+            # A ghost joined to what is leaving it is no still blob: its still part is judged.
+            still = change <= self.pixel_k / 2 * np.asarray(level, dtype=np.float32)
+            foreground[ghost_parts(foreground, columns, background, still, level,
+                                   self.pixel_k)] = 0
         if self.still_frames:
             self._drop_still(foreground, columns, level, blobs)
         self._note_healing(columns, change, level, before, foreground)

@@ -196,7 +196,7 @@ class PixelSample:
     not an area average, whose noise would be lower by the averaging), the
     levels are those of full-size pixels, upsampled bilinearly; they are
     smoothed over 5 x 5 pixels afterwards anyway
-    (:func:`~dgmod_ros.core.streaming.foreground.pixel_noise`).
+    (:func:`~dgmod_ros.core.streaming.noise_levels.pixel_noise`).
 
     Parameters
     ----------
@@ -315,7 +315,7 @@ def carry_backgrounds(frames, shape, backgrounds, small_residuals, small_shape, 
     time series on ``V``, starting from the solve's ``L V`` upsampled (``P``).
     The entries the solve called foreground are weighted out: those whose
     residual ``D - L`` (largest over the channels) exceeds three times the
-    pixel's noise level (:func:`~dgmod_ros.core.streaming.foreground.pixel_noise`
+    pixel's noise level (:func:`~dgmod_ros.core.streaming.noise_levels.pixel_noise`
     of that residual), upsampled, any overlap counting. The fit is of the
     detail ``D - P V^T``, and zero detail counts as a tenth of an observed
     frame (a ridge of ``0.1/m``: it shrinks a fully observed pixel's detail
