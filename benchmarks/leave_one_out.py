@@ -60,7 +60,7 @@ GRID = {
     'still_frames': (15, 25, 40),
     'memory_spacing': (5, 10, 20),
     'absorb_frames': (2700, 5400, 10800),
-    'moving_texture_k': (2.0, 3.0, 4.0),
+    'moving_texture_k': (1.5, 2.0, 3.0),
     'texture_bits': (6, 8, 10),
     'mrf_beta': (1.0, 2.0, 3.0),
 }

@@ -272,7 +272,7 @@ PARAMETERS = (
               'one', active_when=_PER_PIXEL),
     Parameter('texture_bits', 8, 'largest LBSP Hamming distance (of 16 bits per channel) of a '
               'change of light', 0, 48, active_when={'texture_cue': True}),
-    Parameter('moving_texture_k', 3.0, 'pixels whose LBSP texture changed (moving_texture_bits '
+    Parameter('moving_texture_k', 2.0, 'pixels whose LBSP texture changed (moving_texture_bits '
               'or more) and that moved over 5 frames are foreground from this multiple of the '
               'noise level instead of pixel_k (a person whose colour matches what is behind); '
               '0 = off', 0.0, 100.0, active_when=_PER_PIXEL),

@@ -94,8 +94,8 @@ def test_a_person_who_stops_dead_stays_foreground(data_dir):
 def test_the_place_a_person_stood_on_from_the_first_frame_clears_as_he_walks_off(data_dir):
     # sbi_CaVignal: the person stands from the first frame (he is the window's
     # background) and walks off from about frame 140; his old place and he are
-    # one blob until about frame 183. Scored over frames 140-199: F 0.812
-    # (Pr 0.774) with the ghost test on the still parts of blobs, 0.721
+    # one blob until about frame 183. Scored over frames 140-199: F 0.813
+    # (Pr 0.774) with the ghost test on the still parts of blobs, 0.722
     # (Pr 0.624) with whole blobs only (docs/results.md).
     from dgmod_ros import config
     from dgmod_ros.evaluation import load_dataset

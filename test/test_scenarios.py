@@ -60,7 +60,7 @@ def test_background_and_people_come_from_the_people_clips(material):
         assert np.all(np.diff([c.frame for c in track.cutouts]) == 1)
 
 
-@pytest.mark.parametrize('name', ['in_view', 'stops', 'close_up', 'crossing'])
+@pytest.mark.parametrize('name', ['in_view', 'stops', 'close_up', 'crossing', 'close_in_view'])
 def test_ground_truth_is_the_pasted_alpha(suite, name):
     from dgmod_ros.scenarios.compose import BAND_ALPHA
     scenario = suite[name]
@@ -143,6 +143,20 @@ def test_close_up_covers_30_to_60_percent_of_the_view(suite):
     assert (truth[-1] == 255).any()
 
 
+def test_close_in_view_is_close_up_from_the_first_frame(suite):
+    scenario = suite['close_in_view']
+    assert scenario.phases['close'] == (0, len(scenario) - 1)
+    assert np.all(scenario.actors[0].pose >= 0)
+    shares = [np.mean(scenario.coverage(k) > 0.5)
+              for k in np.linspace(0, len(scenario) - 1, 9).astype(int)]
+    assert 0.3 <= min(shares) and max(shares) <= 0.6
+    assert (scenario.render(0)[1][-1] == 255).any()
+    # moving about: the middle of the body is never uncovered, its sides are
+    covered = [scenario.coverage(k) > 0.5 for k in range(len(scenario))]
+    always, ever = np.logical_and.reduce(covered), np.logical_or.reduce(covered)
+    assert always.any() and (ever & ~always).any()
+
+
 def test_crossing_people_pass_each_other(suite):
     scenario = suite['crossing']
     a, b = scenario.actors
@@ -206,12 +220,15 @@ def test_command_line_writes_the_suite(material, data_dir, tmp_path, monkeypatch
 # The streaming detector at the package defaults on the short suite (seed 0):
 # (F floor, person recall floor), each about 0.03 below the figure measured on
 # the same frames (docs/results.md, "The scenario suite"). Low where the
-# detector is known to fail (issue 22): people in view from the first frame.
+# detector is known to fail (issue 22): people in view from the first frame
+# (at this scale close_in_view's 45 frames are over before a window solve has
+# seen the person move: the figures are the warm-up's).
 SCENARIO_FLOORS = {
-    'in_view': (0.45, 0.18),        # measured F 0.487, person recall 0.217
+    'in_view': (0.47, 0.19),        # measured F 0.498, person recall 0.225
     'stops': (0.96, 0.97),          # measured 0.995, 1.000
     'close_up': (0.92, 0.97),       # measured 0.955, 1.000 (0.495, 0.176 with every fit whole)
     'crossing': (0.96, 0.97),       # measured 0.992, 1.000
+    'close_in_view': (0.46, 0.21),  # measured 0.493, 0.244
 }
 
 

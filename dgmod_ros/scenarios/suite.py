@@ -1,7 +1,7 @@
 # Copyright 2026 dgmod_ros authors
 # Licensed under the Apache License, Version 2.0
 """
-The scenario suite: four scripted behaviours on real backgrounds with real people.
+The scenario suite: five scripted behaviours on real backgrounds with real people.
 
 =====================  =========================================================
 ``in_view``            two people in view from the first frame, each moving
@@ -16,6 +16,10 @@ The scenario suite: four scripted behaviours on real backgrounds with real peopl
 ``crossing``           two people at different depths enter from opposite
                        sides, linger, cross each other (the near one hides the
                        far one), linger on the other side, leave (about 22 s)
+``close_in_view``      ``close_up``'s person in view from the first frame,
+                       moving about (15 s): the background behind the middle
+                       of the body is never seen (a robot that starts up
+                       beside someone)
 =====================  =========================================================
 
 Frame rate 30 frames/s, the robot camera's: the detector's rules count frames
@@ -35,7 +39,7 @@ from .material import load_material
 
 FPS = 30.0
 WALK_SPEED = 0.75 / FPS     # body heights per frame
-SCENARIO_NAMES = ('in_view', 'stops', 'close_up', 'crossing')
+SCENARIO_NAMES = ('in_view', 'stops', 'close_up', 'crossing', 'close_in_view')
 CLOSE_UP_COVERAGE = (0.35, 0.5)
 
 
@@ -129,8 +133,8 @@ def _close_up_height(background, track, x, coverage):
     return float(height)
 
 
-def close_up(material, rng, scale):
-    """Script a person close to the camera covering 30-60% of the view, moving about."""
+def _close_person(material, rng):
+    """Draw a background, a close-up track, its column, height and feet row."""
     clips = sorted(material.backgrounds)
     background = material.backgrounds[rng.choice(clips)]
     rows, cols = background.image.shape[:2]
@@ -141,6 +145,13 @@ def close_up(material, rng, scale):
     height = _close_up_height(background, track, centre, rng.uniform(*CLOSE_UP_COVERAGE))
     # the head stays in view: a person taller than the frame is cut lower
     feet = rows - 1.0 + max(height - 0.97 * rows, 0.0)
+    return background, track, centre, height, feet
+
+
+def close_up(material, rng, scale):
+    """Script a person close to the camera covering 30-60% of the view, moving about."""
+    background, track, centre, height, feet = _close_person(material, rng)
+    cols = background.image.shape[1]
     width = _width(track, height)
     side = rng.choice((-1, 1))
     script = Script(-side * (0.6 * width) + (cols if side < 0 else 0), feet, FPS, len(track), rng)
@@ -152,6 +163,18 @@ def close_up(material, rng, scale):
     actor = script.actor(track.cutouts, track.height, lambda _: height, count)
     return background, [actor], count, {'close': (first, count - 1)}, \
         'a person close to the camera, cut by the frame, moving about'
+
+
+def close_in_view(material, rng, scale):
+    """Script ``close_up``'s person in view from the first frame, moving about."""
+    background, track, centre, height, feet = _close_person(material, rng)
+    cols = background.image.shape[1]
+    script = Script(centre, feet, FPS, len(track), rng)
+    script.linger(_frames(15, scale), 0.12 * cols, 0.0)
+    count = len(script)
+    actor = script.actor(track.cutouts, track.height, lambda _: height, count)
+    return background, [actor], count, {'close': (0, count - 1)}, \
+        'a person close to the camera, cut by the frame, in view from the first frame'
 
 
 def crossing(material, rng, scale):
@@ -186,7 +209,8 @@ def crossing(material, rng, scale):
         'two people at different depths linger and cross each other'
 
 
-BUILDERS = {'in_view': in_view, 'stops': stops, 'close_up': close_up, 'crossing': crossing}
+BUILDERS = {'in_view': in_view, 'stops': stops, 'close_up': close_up, 'crossing': crossing,
+            'close_in_view': close_in_view}
 
 
 def build_scenario(name, material, seed=0, duration_scale=1.0):

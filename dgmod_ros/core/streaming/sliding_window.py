@@ -174,7 +174,7 @@ class SlidingWindowDetector(StreamingDetector):
         candidate.
     texture_bits : int, default=8
         Largest LBSP Hamming distance of a change of light.
-    moving_texture_k : float, default=3.0
+    moving_texture_k : float, default=2.0
         > 0: a pixel whose LBSP texture differs from the background's in at
         least ``moving_texture_bits`` bits and that changed against the frame
         5 frames before is foreground from this multiple of its noise level
@@ -241,7 +241,7 @@ class SlidingWindowDetector(StreamingDetector):
                  hold_changes=False, absorb_frames=5400, decision='adaptive',
                  noise_source='solve', pixel_k=6.0, median_size=5, ghost_test=True,
                  still_frames=25, mrf_beta=2.0, chroma_cue=True, texture_cue=True,
-                 texture_bits=8, moving_texture_k=3.0, moving_texture_bits=16, solve_lag=5,
+                 texture_bits=8, moving_texture_k=2.0, moving_texture_bits=16, solve_lag=5,
                  solve_pixels=19200, solve_scale=0.5, refit_background=True):
         self.model = model
         self.window = window
