@@ -248,8 +248,9 @@ PARAMETERS = (
               'decision thresholds); max: the larger of the solve and projection levels',
               choices=_choices(SlidingWindowDetector, 'noise_source'), active_when=_PER_PIXEL,
               advanced=True),
-    Parameter('ghost_test', True, 'drop still blobs whose outline is an edge of the background '
-              'rather than of the frame (ghosts of what has left); they heal the window',
+    Parameter('ghost_test', True, 'drop still blobs, and still parts of blobs, whose outline '
+              'is an edge of the background rather than of the frame (ghosts of what has '
+              'left); they heal the window',
               active_when=_PER_PIXEL),
     Parameter('still_frames', 25, 'drop pixels that have been in a still blob (nothing in it '
               'changed by pixel_k / 2 noise levels over 5 frames) for this many frames, unless '
