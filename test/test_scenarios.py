@@ -221,8 +221,8 @@ def test_command_line_writes_the_suite(material, data_dir, tmp_path, monkeypatch
 # (F floor, person recall floor), each about 0.03 below the figure measured on
 # the same frames (docs/results.md, "The scenario suite"). Low where the
 # detector is known to fail (issue 22): people in view from the first frame
-# (at this scale close_in_view's 45 frames are over before a window solve has
-# seen the person move: the figures are the warm-up's).
+# (at this scale close_in_view is 45 frames, most of them while the window
+# still fills with consecutive frames: the figures are those of a first start).
 SCENARIO_FLOORS = {
     'in_view': (0.47, 0.19),        # measured F 0.498, person recall 0.225
     'stops': (0.96, 0.97),          # measured 0.995, 1.000
