@@ -69,20 +69,10 @@ def ghost_labels(blobs, mask, frame, background, k):
     # The borders lie within a pixel of the blobs and their gradients read one
     # pixel further: the frame's box around the blobs grown by 2 holds all
     # that the test reads (the operations are per pixel, the same in the box).
-    rows, cols = mask.shape
-    top, bottom = _span(mask.any(axis=1), rows)
-    left, right = _span(mask.any(axis=0), cols)
-    box = np.s_[top:bottom, left:right]
-    square = np.ones((3, 3), np.uint8)
-    border = cv2.morphologyEx(mask[box], cv2.MORPH_GRADIENT, square) > 0
-    # Border pixels just outside a blob take the blob's label from a 3 x 3 dilation.
-    owner = cv2.dilate(blobs.labels[box].astype(np.float32), square)
-    owner = owner.astype(np.int32)[border]
-    channels = frame.shape[0]
-    frame_edges = _edge_strength(frame.reshape(channels, rows, cols)[(slice(None),) + box]
-                                 .mean(axis=0))[border]
-    background_edges = _edge_strength(
-        background.reshape(channels, rows, cols)[(slice(None),) + box].mean(axis=0))[border]
+    box = _box(mask, margin=2)
+    border, owner = _outline(mask[box], blobs.labels[box])
+    frame_edges = _edge_strength(_grey(frame, mask.shape, box))[border]
+    background_edges = _edge_strength(_grey(background, mask.shape, box))[border]
     in_frame = np.bincount(owner, frame_edges, minlength=blobs.count)
     in_background = np.bincount(owner, background_edges, minlength=blobs.count)
     return ghost & (in_background > in_frame)
@@ -127,21 +117,17 @@ def ghost_parts(mask, frame, background, still, noise, k):
         return ghosts
     # The outline's pixels and their derivatives read two pixels around the
     # blobs, the smoothed mask's normal two more: the box grown by 4 holds it.
-    top, bottom = _span(mask.any(axis=1), rows, margin=4)
-    left, right = _span(mask.any(axis=0), cols, margin=4)
-    box = np.s_[top:bottom, left:right]
+    box = _box(mask, margin=4)
     boxed, still = mask[box], still[box]
     count, labels = cv2.connectedComponents(((boxed > 0) & still).astype(np.uint8),
                                             connectivity=8)
-    square = np.ones((3, 3), np.uint8)
-    outline = cv2.morphologyEx(boxed, cv2.MORPH_GRADIENT, square) > 0
-    owner = cv2.dilate(labels.astype(np.float32), square).astype(np.int32)[outline]
+    outline, owner = _outline(boxed, labels)
     smooth = cv2.GaussianBlur(boxed.astype(np.float32), (5, 5), 0)
     normal_x, normal_y = cv2.Sobel(smooth, cv2.CV_32F, 1, 0), cv2.Sobel(smooth, cv2.CV_32F, 0, 1)
     length = np.hypot(normal_x, normal_y) + np.float32(1e-6)
 
     def across(image):
-        grey = image.reshape(image.shape[0], rows, cols)[(slice(None),) + box].mean(axis=0)
+        grey = _grey(image, mask.shape, box)
         derivative = (cv2.Sobel(grey, cv2.CV_32F, 1, 0) * normal_x
                       + cv2.Sobel(grey, cv2.CV_32F, 0, 1) * normal_y)
         return (np.abs(derivative) / length)[outline]
@@ -156,6 +142,33 @@ def ghost_parts(mask, frame, background, still, noise, k):
     ghost[0] = False
     ghosts[box] = ghost[labels]
     return ghosts
+
+
+def _box(mask, margin):
+    """Return the slices of ``mask``'s box around its nonzero pixels, grown by ``margin``."""
+    rows, cols = mask.shape
+    top, bottom = _span(mask.any(axis=1), rows, margin)
+    left, right = _span(mask.any(axis=0), cols, margin)
+    return np.s_[top:bottom, left:right]
+
+
+def _outline(mask, labels):
+    """
+    Return the outline (rows, cols) bool of ``mask`` and each outline pixel's owner label.
+
+    The outline is the pixels within a pixel of the mask's edge, on both
+    sides; those just outside take a label of ``labels`` from a 3 x 3
+    dilation (the largest one next to them).
+    """
+    square = np.ones((3, 3), np.uint8)
+    outline = cv2.morphologyEx(mask, cv2.MORPH_GRADIENT, square) > 0
+    owner = cv2.dilate(labels.astype(np.float32), square).astype(np.int32)[outline]
+    return outline, owner
+
+
+def _grey(image, shape, box):
+    """Return the channel mean (rows, cols) in ``box`` of an image given as (C, n) columns."""
+    return image.reshape((image.shape[0],) + tuple(shape))[(slice(None),) + box].mean(axis=0)
 
 
 def _span(occupied, size, margin=2):

@@ -441,12 +441,16 @@ class SlidingWindowDetector(StreamingDetector):
         result, columns = pending
         background, level = self._background(columns)
         earlier = self.recent_[0][1] if len(self.recent_) == self.recent_.maxlen else None
-        # Each pixel's change against the earlier frame, for the rules that ask it of pixels.
+        # Each pixel's change against the earlier frame, for the rules that ask it of pixels,
+        # and the still test they share: within pixel_k / 2 noise levels of it.
         change = None if earlier is None else np.abs(columns - earlier).max(axis=0)
-        foreground, changed = self._decide(result, columns, background, level, earlier, change)
-        self._note_still(columns, change, level)
+        still = (None if change is None or self.decision == 'global'
+                 else change <= self.pixel_k / 2 * np.asarray(level, dtype=np.float32))
+        foreground, changed = self._decide(result, columns, background, level, earlier, change,
+                                           still)
+        self._note_still(columns, still)
         result.buffered = self._admit(columns, background, foreground, result.frame_id,
-                                      result.magnitude, level, change)
+                                      result.magnitude, level, still)
         self.previous_foreground_ = foreground.ravel() > 0
         self.recent_.append((result.frame_id, columns))
         result.model_ready = self.background_model_ is not None
@@ -457,7 +461,7 @@ class SlidingWindowDetector(StreamingDetector):
             self._restart_from_newest(SceneChangeWatch.FRAMES)
         return result
 
-    def _decide(self, result, columns, background, level, earlier, change):
+    def _decide(self, result, columns, background, level, earlier, change, still):
         """
         Set ``result``'s magnitude and mask; return the processing-size foreground and the changes.
 
@@ -481,11 +485,11 @@ class SlidingWindowDetector(StreamingDetector):
         changed = result.magnitude.ravel() > self.pixel_k * level
         if ((self.ghost_test or self.still_frames) and model is not None
                 and earlier is not None):
-            self._blob_rules(foreground, columns, background, level, earlier, change)
+            self._blob_rules(foreground, columns, background, level, earlier, change, still)
         result.mask = to_input_size(foreground, self.input_shape_)
         return foreground, changed
 
-    def _blob_rules(self, foreground, columns, background, level, earlier, change):
+    def _blob_rules(self, foreground, columns, background, level, earlier, change, still):
         """Drop, in place, the ghost blobs and the blobs held still from ``foreground``."""
         # One labelling for both tests: the ghost test drops whole blobs.
         blobs = BlobMotion(foreground, columns, earlier, level)
@@ -497,12 +501,11 @@ class SlidingWindowDetector(StreamingDetector):
             blobs.drop(ghost_labels(blobs, foreground, columns, background, self.pixel_k),
                        foreground)
             # A ghost joined to what is leaving it is no still blob: its still part is judged.
-            still = change <= self.pixel_k / 2 * np.asarray(level, dtype=np.float32)
             foreground[ghost_parts(foreground, columns, background, still, level,
                                    self.pixel_k)] = 0
         if self.still_frames:
             self._drop_still(foreground, columns, level, blobs)
-        self._note_healing(columns, change, level, before, foreground)
+        self._note_healing(columns, still, before, foreground)
 
     def _drop_still(self, foreground, columns, level, blobs):
         """Clear, in place, the pixels of ``foreground`` held still for ``still_frames``."""
@@ -511,21 +514,19 @@ class SlidingWindowDetector(StreamingDetector):
         self.still_age_ = consecutive_frames(self.still_age_, still)
         foreground[self.still_age_.reshape(foreground.shape) >= self.still_frames] = 0
 
-    def _note_healing(self, columns, change, level, candidate, foreground):
+    def _note_healing(self, columns, still, candidate, foreground):
         """
         Remember where the window should take the frame (blob tests' drops) and the frame there.
 
         ``candidate`` (rows, cols) bool is the foreground before the blob
-        tests, ``foreground`` after them, ``change`` (n,) each pixel's change
-        against the frame ``_GHOST_LAG`` frames before. A pixel heals when a blob test
-        dropped it, it was not seen to come in and it has held still (within
+        tests, ``foreground`` after them, ``still`` (n,) the pixels within
         ``pixel_k / 2`` noise levels of the frame ``_GHOST_LAG`` frames
-        before) for ``still_frames`` frames as a candidate: the place behind
-        holds still, while leaves that a blob test dropped keep moving and
-        keep their window.
+        before. A pixel heals when a blob test dropped it, it was not seen to
+        come in and it has held still for ``still_frames`` frames as a
+        candidate: the place behind holds still, while leaves that a blob
+        test dropped keep moving and keep their window.
         """
-        holding = candidate.ravel() & ~self.entered_
-        holding &= change <= self.pixel_k / 2 * np.asarray(level, dtype=np.float32)
+        holding = candidate.ravel() & ~self.entered_ & still
         self.uncovered_age_ = consecutive_frames(self.uncovered_age_, holding)
         uncovered = ((self.uncovered_age_ >= max(int(self.still_frames), _GHOST_LAG))
                      & (foreground.ravel() == 0))
@@ -538,11 +539,11 @@ class SlidingWindowDetector(StreamingDetector):
         pixels |= uncovered
         values[:, uncovered] = columns[:, uncovered]
 
-    def _note_still(self, columns, change, level):
+    def _note_still(self, columns, still):
         """
         Keep each pixel's newest settled value and mark the pixels moving now.
 
-        A pixel holds still when its ``change`` against the frame
+        A pixel holds still (``still``) when its change against the frame
         ``_GHOST_LAG`` frames before is within ``pixel_k / 2`` noise levels
         (the still test of the blob rules); it has settled once it has held
         still for ``_GHOST_LAG`` frames in a row (the same value over twice
@@ -554,9 +555,8 @@ class SlidingWindowDetector(StreamingDetector):
         samples with the least motion. A pixel that never settled (leaves
         that never rest) is admitted as it is.
         """
-        if change is None or self.decision == 'global':
+        if still is None:               # no earlier frame yet, or the global decision
             return
-        still = change <= self.pixel_k / 2 * np.asarray(level, dtype=np.float32)
         self.held_still_ = consecutive_frames(self.held_still_, still)
         settled = self.held_still_ >= _GHOST_LAG
         if self.still_value_ is None:
@@ -566,12 +566,12 @@ class SlidingWindowDetector(StreamingDetector):
         self.still_known_ |= settled
         self.moving_ = ~still & self.still_known_
 
-    def _admit(self, columns, background, foreground, frame_id, distance, level, change):
+    def _admit(self, columns, background, foreground, frame_id, distance, level, still):
         """
         Put the frame into the window if due (conditionally); return whether it went in.
 
-        ``change`` (n,) is each pixel's change against the frame
-        ``_GHOST_LAG`` frames before (None while there is none).
+        ``still`` (n,) marks the pixels within ``pixel_k / 2`` noise levels of
+        the frame ``_GHOST_LAG`` frames before (None while there is none).
         """
         self.foreground_age_ = consecutive_frames(self.foreground_age_, foreground > 0)
         if self.entered_ is not None:
@@ -596,7 +596,7 @@ class SlidingWindowDetector(StreamingDetector):
                        and len(self.buffer_) >= self.buffer_.capacity)
             held = foreground
             if replace and self.hold_changes and self.decision != 'global':
-                held = self._held(foreground, distance, level, change)
+                held = self._held(foreground, still)
             # Dilated: a silhouette's border is foreground below the threshold.
             grown = cv2.dilate(held, _BORDER_KERNEL).ravel() > 0
             columns, observed = conditional_columns(columns, background, grown,
@@ -612,12 +612,9 @@ class SlidingWindowDetector(StreamingDetector):
         self.buffer_.append(columns, frame_id, observed)
         return True
 
-    def _held(self, foreground, distance, level, change):
+    def _held(self, foreground, still):
         """Return the frame's pixels (rows, cols) uint8 that the conditional update keeps out."""
-        if change is None:
-            changing = np.zeros_like(self.away_)
-        else:
-            changing = change > self.pixel_k / 2 * level
+        changing = np.zeros_like(self.away_) if still is None else ~still
         held = held_pixels(foreground, self.away_, changing, self.away_age_,
                            self.still_frames)
         return np.where(held, np.uint8(255), np.uint8(0)).reshape(foreground.shape)
