@@ -140,7 +140,9 @@ PARAMETERS = (
               '(graphs without the nuclear norm); median (temporal median); OpenCV mog2 / knn '
               'run per frame. Comparators use their documented defaults.',
               choices=_WINDOW_METHODS + _OPENCV_METHODS, acts=EVERYWHERE),
-    Parameter('window', 30, 'frames m in the sliding window', 2, 300, acts=EVERYWHERE),
+    Parameter('window', 30, 'frames m in the sliding window (streaming: the consecutive frames '
+              'it fills with, then memory_columns spaced memory_spacing apart)', 2, 300,
+              acts=EVERYWHERE),
     Parameter('stride', 10, 'buffered frames between window solves (<= window)', 1, 300),
     Parameter('scale', 0.5, 'processing scale of frames for the per-frame path (projection, '
               'decision) and the window; masks come back at input size. The window solve runs '
@@ -156,8 +158,12 @@ PARAMETERS = (
               'that restarts the window (light switched, exposure jump); 1.0 disables',
               0.01, 1.0, active_when=_WINDOW),
     Parameter('memory_spacing', 10, 'frames between admissions to the full window, which '
-              'then spans window * memory_spacing frames; 1 = consecutive frames', 1, 1000,
-              active_when=_WINDOW),
+              'then spans memory_columns * memory_spacing frames; 1 = consecutive frames', 1,
+              1000, active_when=_WINDOW),
+    Parameter('memory_columns', 10, 'columns the full window settles to (at most window): '
+              "after the window's first, consecutive frames each admission drops the oldest "
+              'column, and one more while the window holds more; each column weighs 1 / '
+              'memory_columns in the solve', 2, 300, active_when=_WINDOW),
     Parameter('conditional_update', True, 'admit frames with their foreground replaced by the '
               'background, so that a person who stops stays foreground', active_when=_WINDOW),
     Parameter('hold_changes', False, 'the conditional update also keeps out the pixels over '
@@ -575,6 +581,7 @@ def detector_settings(values):
             'min_frames': values['min_frames'], 'basis_rank': values['basis_rank'],
             'global_change_fraction': values['global_change_fraction'],
             'memory_spacing': values['memory_spacing'],
+            'memory_columns': values['memory_columns'],
             'conditional_update': values['conditional_update'],
             'hold_changes': values['hold_changes'],
             'absorb_frames': values['absorb_frames'], 'decision': values['decision'],

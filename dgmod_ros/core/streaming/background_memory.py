@@ -5,9 +5,10 @@ The window the model solves: frames spread over a long span, foreground left out
 
 A window of ``m`` consecutive frames forgets in ``m`` frames: a person who
 stands still for half a window is learned into the background ``L`` and
-vanishes from the masks. :class:`BackgroundMemory` keeps the same ``m``
-columns but admits a frame only every ``spacing`` frames once it is full, so
-the window spans ``m * spacing`` frames, and it admits a frame
+vanishes from the masks. :class:`BackgroundMemory` fills with ``m``
+consecutive frames (the first solves separate what moves in them) and then
+admits a frame only every ``spacing`` frames, settling to ``kept`` columns
+that span ``kept * spacing`` frames, and it admits a frame
 conditionally: where the frame's own mask says foreground, the column holds
 the current background instead of the frame (the pixel counts as not
 observed). A person who stops therefore stays foreground, while everything
@@ -17,8 +18,16 @@ observed, so that the noise levels of the first solves leave out a person
 the first masks saw. A pixel that has been
 foreground for ``absorb_frames`` frames in a row is admitted as it is, so an
 object that stays (or a mistake of the masks) joins the background after
-about ``absorb_frames + m * spacing / 2`` frames, when the l1 fit lets the
+about ``absorb_frames + kept * spacing / 2`` frames, when the l1 fit lets the
 majority of the window win.
+
+How many columns the full window keeps is how many admissions of what the
+masks call background it takes to outvote what the window learnt. A person in
+view from the first frame is in every column of the fill; the place behind
+them enters as they move (or heals, below) and must become the majority. The
+fill's consecutive frames are what the first solves need, but they are one
+second of a scene, not ``m`` independent views of it: after the fill they
+leave two at a time until ``kept`` columns are left.
 
 What the masks miss is learnt, and learning it hides it further: a slow
 walker whose legs fall below the threshold enters the window at every
@@ -31,7 +40,7 @@ that the held-still rule released).
 
 A ghost the blob tests dropped would heal only as fast as admissions replace
 the window's columns (a window of 30 columns 10 frames apart holds the
-departed object for 150 frames as the l1 majority). Where the place behind
+departed object for 150 frames as the l1 majority, 10 columns for 50). Where the place behind
 has held still (the sliding-window detector's ``_note_healing``),
 :meth:`BackgroundMemory.overwrite` puts the frame there into every column
 at the next admission, the way ViBe and SuBSENSE re-seed the samples of a
@@ -52,20 +61,27 @@ class BackgroundMemory(FrameWindow):
     Parameters
     ----------
     capacity : int
-        Columns kept (the window ``m``).
+        Frames the window fills with, admitted one after the other so that
+        the first solves have frames to work on.
     spacing : int
         Frames between admissions once the window is full (1: every frame,
-        the plain sliding window). While filling, every frame is admitted so
-        that the first solves have frames to work on.
+        the plain sliding window).
+    kept : int or None
+        Columns the full window settles to (at most ``capacity``; None:
+        ``capacity``). Each admission after the fill drops the oldest column,
+        and one more while the window holds more than ``kept`` (the fill's
+        consecutive frames leave two at a time) or none while it holds fewer.
 
     """
 
-    def __init__(self, capacity, spacing=1):
+    def __init__(self, capacity, spacing=1, kept=None):
         super().__init__(capacity)
         self.spacing = int(spacing)
+        self.kept = self.capacity if kept is None else min(int(kept), self.capacity)
         self._observed = deque(maxlen=int(capacity))
         self.admitted = 0               # columns admitted so far (warm-start bookkeeping)
         self.last_admitted_id = None
+        self.filling = True             # every frame is admitted until the window is full
 
     @property
     def first_column(self):
@@ -74,16 +90,22 @@ class BackgroundMemory(FrameWindow):
 
     def wants(self, frame_id):
         """Tell whether the frame ``frame_id`` is due for admission."""
-        if len(self) < self.capacity or self.last_admitted_id is None:
+        if self.filling or self.last_admitted_id is None:
             return True
         return frame_id - self.last_admitted_id >= self.spacing
 
     def append(self, columns, frame_id, observed=None):
         """Admit a frame's columns (C, n); ``observed`` (n,) bool marks the pixels noise counts."""
+        if not self.filling:
+            # One column closer to ``kept`` with each admission.
+            for _ in range(1 + int(np.sign(len(self) - self.kept))):
+                for store in (self._ids, self._frames, self._observed):
+                    store.popleft()
         super().append(columns, frame_id)
         self._observed.append(observed)
         self.admitted += 1
         self.last_admitted_id = frame_id
+        self.filling = self.filling and len(self) < self.capacity
 
     def observed(self):
         """Return the observed pixels of the columns (n, m) bool, or None when all are."""
@@ -113,10 +135,11 @@ class BackgroundMemory(FrameWindow):
                 store.append(entry)
 
     def clear(self):
-        """Forget every column (the admission count goes on)."""
+        """Forget every column (the admission count goes on); the window fills again."""
         for store in (self._ids, self._frames, self._observed):
             store.clear()
         self.last_admitted_id = None
+        self.filling = True
 
     def keep_newest(self, count):
         """Drop all but the newest ``count`` columns; return how many remain."""
@@ -129,10 +152,12 @@ class BackgroundMemory(FrameWindow):
             self._observed.append(observed)
         return len(recent)
 
-    def resize(self, capacity):
-        """Keep at most ``capacity`` columns from now on, the newest first."""
+    def resize(self, capacity, kept=None):
+        """Keep at most ``capacity`` columns (the newest) and settle to ``kept`` from now on."""
         super().resize(capacity)
         self._observed = deque(self._observed, maxlen=int(capacity))
+        self.kept = self.capacity if kept is None else min(int(kept), self.capacity)
+        self.filling = self.filling and len(self) < self.capacity
 
     def rescale(self, old_shape, new_shape):
         """Resample every column to ``new_shape``; every pixel counts as observed again."""

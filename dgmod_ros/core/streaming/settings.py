@@ -29,6 +29,7 @@ WINDOW_CONSTRAINTS = {
     'global_change_fraction': [Interval(Real, 0, 1, closed='right')],
     'basis_rank': POSITIVE_INTEGER,
     'memory_spacing': POSITIVE_INTEGER,
+    'memory_columns': [Interval(Integral, 2, None)],
     'absorb_frames': POSITIVE_INTEGER,
     'decision': [Options('adaptive', 'uniform', 'global')],
     'noise_source': [Options(*NOISE_SOURCES)],

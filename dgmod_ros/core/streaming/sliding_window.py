@@ -69,7 +69,8 @@ class SlidingWindowDetector(StreamingDetector):
         only the solve's temporal factors (``docs/results.md`` has the
         measured effect of the sweep count).
     window : int, default=30
-        Columns ``m`` kept in the window.
+        Frames ``m`` the window fills with, one after the other: the first
+        solves separate what moves in them.
     stride : int, default=10
         Frames between solves.
     scale : float, default=0.5
@@ -102,8 +103,17 @@ class SlidingWindowDetector(StreamingDetector):
         fraction would also restart the window.
     memory_spacing : int, default=10
         Frames between admissions to the full window, so that it spans
-        ``window * memory_spacing`` frames; 1 is the window of consecutive
-        frames.
+        ``memory_columns * memory_spacing`` frames; 1 (with
+        ``memory_columns >= window``) is the window of consecutive frames.
+    memory_columns : int, default=10
+        Columns the full window settles to (at most ``window``): each
+        admission after the fill drops the oldest column, and one more while
+        the window holds more (the fill's frames leave two at a time). Each
+        column weighs ``1 / memory_columns`` in the solve's l1 fit, so this
+        sets how many admissions of what the masks call background it takes
+        to replace what the window learnt: a person in view from the first
+        frame is learnt, and the place behind them, seen as they move, must
+        outvote them (``docs/results.md``).
     conditional_update : bool, default=True
         Admit a frame with its foreground (the mask, dilated by 5 x 5 at the
         processing size) replaced by the background, so that a person who
@@ -122,8 +132,8 @@ class SlidingWindowDetector(StreamingDetector):
         spread, and the leaves come through (``docs/results.md``).
     absorb_frames : int, default=5400
         Foreground older than this many frames is admitted as it is (a left
-        object joins the background after about ``absorb_frames + window *
-        memory_spacing / 2`` frames).
+        object joins the background after about ``absorb_frames +
+        memory_columns * memory_spacing / 2`` frames).
     decision : {'adaptive', 'uniform', 'global'}, default='adaptive'
         'adaptive': each pixel against ``pixel_k`` times its own noise level;
         'uniform': the same with the frame's typical noise level for all
@@ -237,12 +247,12 @@ class SlidingWindowDetector(StreamingDetector):
 
     def __init__(self, model=None, window=30, stride=10, scale=0.5, color='rgb',
                  mask_rule=None, motion_threshold=0.0, min_frames=5, basis_rank=2,
-                 global_change_fraction=0.7, memory_spacing=10, conditional_update=True,
-                 hold_changes=False, absorb_frames=5400, decision='adaptive',
-                 noise_source='solve', pixel_k=6.0, median_size=5, ghost_test=True,
-                 still_frames=25, mrf_beta=2.0, chroma_cue=True, texture_cue=True,
-                 texture_bits=8, moving_texture_k=2.0, moving_texture_bits=16, solve_lag=5,
-                 solve_pixels=19200, solve_scale=0.5, refit_background=True):
+                 global_change_fraction=0.7, memory_spacing=10, memory_columns=10,
+                 conditional_update=True, hold_changes=False, absorb_frames=5400,
+                 decision='adaptive', noise_source='solve', pixel_k=6.0, median_size=5,
+                 ghost_test=True, still_frames=25, mrf_beta=2.0, chroma_cue=True,
+                 texture_cue=True, texture_bits=8, moving_texture_k=2.0, moving_texture_bits=16,
+                 solve_lag=5, solve_pixels=19200, solve_scale=0.5, refit_background=True):
         self.model = model
         self.window = window
         self.stride = stride
@@ -254,6 +264,7 @@ class SlidingWindowDetector(StreamingDetector):
         self.basis_rank = basis_rank
         self.global_change_fraction = global_change_fraction
         self.memory_spacing = memory_spacing
+        self.memory_columns = memory_columns
         self.conditional_update = conditional_update
         self.hold_changes = hold_changes
         self.absorb_frames = absorb_frames
@@ -323,7 +334,7 @@ class SlidingWindowDetector(StreamingDetector):
         if 'color' in params and params['color'] != old['color']:
             self.reset()
             return self
-        self.buffer_.resize(int(self.window))
+        self.buffer_.resize(int(self.window), int(self.memory_columns))
         self.buffer_.spacing = int(self.memory_spacing)
         if ('scale' in params and params['scale'] != old['scale']
                 and self.input_shape_ is not None):
@@ -355,7 +366,8 @@ class SlidingWindowDetector(StreamingDetector):
     def reset(self):
         """Forget every buffered frame and the background model."""
         self._new_generation()
-        self.buffer_ = BackgroundMemory(int(self.window), int(self.memory_spacing))
+        self.buffer_ = BackgroundMemory(int(self.window), int(self.memory_spacing),
+                                        int(self.memory_columns))
         self.column_cache_ = ColumnCache()
         self._forget_pixel_histories()
         self.recent_ = deque(maxlen=_GHOST_LAG)
@@ -592,8 +604,7 @@ class SlidingWindowDetector(StreamingDetector):
             # solves must separate whatever moves in the first frames, and a
             # model learnt from a few frames is no ground for holding pixels
             # back. Its foreground is only left out of the noise levels.
-            replace = (self.background_model_ is not None
-                       and len(self.buffer_) >= self.buffer_.capacity)
+            replace = self.background_model_ is not None and not self.buffer_.filling
             held = foreground
             if replace and self.hold_changes and self.decision != 'global':
                 held = self._held(foreground, still)
@@ -667,8 +678,7 @@ class SlidingWindowDetector(StreamingDetector):
         """
         self._ensure_started()
         if (self.solve_in_flight() or self.background_model_ is None
-                or len(self.buffer_) < self.buffer_.capacity
-                or self.buffer_.last_admitted_id is None):
+                or self.buffer_.filling or self.buffer_.last_admitted_id is None):
             return 0
         ahead = int(self.stride) - self.since_solve_
         # This frame's id; admissions happen when frames are masked (_finish).
