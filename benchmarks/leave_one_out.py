@@ -60,6 +60,7 @@ GRID = {
     'still_frames': (15, 25, 40),
     'memory_spacing': (5, 10, 20),
     'memory_columns': (5, 10, 15),
+    'warm_start': (False, True),
     'absorb_frames': (2700, 5400, 10800),
     'moving_texture_k': (1.5, 2.0, 3.0),
     'texture_bits': (6, 8, 10),

@@ -237,8 +237,13 @@ PARAMETERS = (
               "when the solve runs at the processing size; false: the solve's own L there",
               active_when=_WINDOW, advanced=True),
     Parameter('stream_max_iter', 3, 'ADMM sweeps per window solve while streaming (node, '
-              'stream mode): each solve starts from the last, so sweeps add up over '
-              'overlapping windows', 1, 10000, active_when=_DGMOD, advanced=True),
+              "stream mode), from the window's data (or, with warm_start, from the last "
+              'solve, so that sweeps add up over overlapping windows)', 1, 10000,
+              active_when=_DGMOD, advanced=True),
+    Parameter('warm_start', False, "start each window solve from the last solve's iterates "
+              "instead of from the window's data: sweeps add up, and so does what the first "
+              'windows learnt (a person in view from the first frame)', active_when=_WINDOW,
+              advanced=True),
     Parameter('solve_threads', 1, "threads of the window solve's compiled kernels where it "
               'runs beside the per-frame work (the async node, stream mode); 1 leaves the other '
               'cores to the image callback, DDS and the camera driver; 0 = one per core. The '
@@ -594,7 +599,8 @@ def detector_settings(values):
             'moving_texture_bits': values['moving_texture_bits'],
             'solve_lag': values['solve_lag'], 'solve_pixels': values['solve_pixels'],
             'solve_scale': values['solve_scale'],
-            'refit_background': values['refit_background']}
+            'refit_background': values['refit_background'],
+            'warm_start': values['warm_start']}
 
 
 def validate(values):

@@ -303,6 +303,21 @@ def test_detector_solves_capped_and_warm_starts_at_the_solve_size(frames):
     assert detector.snapshot().solve_shape == (24, 32, 3)
 
 
+def test_a_solve_starts_from_its_window_unless_asked_to_warm_start(frames):
+    # The iterates of earlier solves are no part of the window: by default a
+    # solve reads nothing of the previous model; warm_start starts it there.
+    values = dict(config.DEFAULTS, window=8, stride=3, min_frames=3, memory_spacing=1)
+    detector = config.build_detector(config.validate(values))
+    for frame in frames[:20]:
+        detector.process(frame)
+    snapshot = detector.snapshot()
+    assert snapshot.previous is not None and not snapshot.warm_start
+    alone = solve_window(replace(snapshot, previous=None))
+    assert np.array_equal(solve_window(snapshot).background, alone.background)
+    warm = solve_window(replace(snapshot, warm_start=True))
+    assert not np.allclose(warm.background, alone.background, atol=1e-4)
+
+
 def test_a_snapshot_holds_its_window_while_frames_go_on(frames):
     # The snapshot hands the solve the buffered columns, stacked in the solve's
     # thread: frames admitted after it (conditionally, the oldest dropped)

@@ -105,6 +105,7 @@ class WindowSnapshot:
     noise_source: str = 'solve'  # likewise the residual the pixel noise comes from
     solve_shape: tuple = None   # (rows, cols, C) the window is solved at; None: ``shape``
     refit_background: bool = False  # refit each pixel's series on the solve's factors
+    warm_start: bool = True     # start from ``previous``'s iterates where they fit
     column_cache: object = None  # ColumnCache of the columns in ``data`` (solve_resolution)
     healed: np.ndarray = None   # (n,) bool: pixels the window took a frame at since the last solve
 

@@ -64,10 +64,10 @@ class SlidingWindowDetector(StreamingDetector):
         Object with ``fit(data, frame_shape, init=None)`` setting
         ``background_``, ``foreground_`` and optionally ``state_``,
         ``n_iter_``, ``info_``. None: :class:`DualGraphMOD` with ``tol=1e-3``
-        and at most 3 sweeps per solve: every solve starts from the previous
-        one, so sweeps add up over overlapping windows, and the refit takes
-        only the solve's temporal factors (``docs/results.md`` has the
-        measured effect of the sweep count).
+        and at most 3 sweeps per solve, each solve started from its window's
+        data (``warm_start``); the refit takes only the solve's temporal
+        factors and its foreground (``docs/results.md`` has the measured
+        effect of the sweep count).
     window : int, default=30
         Frames ``m`` the window fills with, one after the other: the first
         solves separate what moves in them.
@@ -218,6 +218,13 @@ class SlidingWindowDetector(StreamingDetector):
         temporal factors, which a coarser frame carries as well, and the
         full-size fit fixes each pixel (``docs/results.md`` has the measured
         effect); 1 solves at the processing size.
+    warm_start : bool, default=False
+        Start each window solve from the previous solve's iterates, shifted
+        by the columns the window moved on, instead of from its data: the
+        sweeps add up over overlapping windows, and so does what the first
+        windows learnt (a person in view from the first frame stays in the
+        iterates after the columns that held them have left; measured in
+        ``docs/results.md``).
     refit_background : bool, default=True
         The window's background is each pixel's own time series fit on the
         solve's leading ``basis_rank`` temporal factors, the entries the
@@ -252,7 +259,8 @@ class SlidingWindowDetector(StreamingDetector):
                  decision='adaptive', noise_source='solve', pixel_k=6.0, median_size=5,
                  ghost_test=True, still_frames=25, mrf_beta=2.0, chroma_cue=True,
                  texture_cue=True, texture_bits=8, moving_texture_k=2.0, moving_texture_bits=16,
-                 solve_lag=5, solve_pixels=19200, solve_scale=0.5, refit_background=True):
+                 solve_lag=5, solve_pixels=19200, solve_scale=0.5, warm_start=False,
+                 refit_background=True):
         self.model = model
         self.window = window
         self.stride = stride
@@ -283,6 +291,7 @@ class SlidingWindowDetector(StreamingDetector):
         self.solve_lag = solve_lag
         self.solve_pixels = solve_pixels
         self.solve_scale = solve_scale
+        self.warm_start = warm_start
         self.refit_background = refit_background
         self._validated = False
 
@@ -707,6 +716,7 @@ class SlidingWindowDetector(StreamingDetector):
                               solve_shape=solve_shape(self.shape_, int(self.solve_pixels),
                                                       float(self.solve_scale)),
                               refit_background=bool(self.refit_background),
+                              warm_start=bool(self.warm_start),
                               column_cache=self.column_cache_, healed=self.healed_)
         self.healed_ = None
 

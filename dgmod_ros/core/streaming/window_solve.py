@@ -26,12 +26,12 @@ def warm_starts(snapshot):
     Return each channel's warm start for the snapshot's solve (None: cold).
 
     The previous solve's states, shifted by the frames the window moved on,
-    when the previous window has the same shape, solve shape and length and
-    still overlaps.
+    when the snapshot asks for a warm start (``warm_start``) and the previous
+    window has the same shape, solve shape and length and still overlaps.
     """
     channels = snapshot.shape[2]
     previous = snapshot.previous
-    if (previous is None or previous.shape != snapshot.shape
+    if (not snapshot.warm_start or previous is None or previous.shape != snapshot.shape
             or _solved_shape(previous) != _solved_shape(snapshot) or not previous.states
             or any(s is None for s in previous.states)):
         return [None] * channels
