@@ -277,7 +277,7 @@ def frames():
 
 def test_detector_solves_capped_and_warm_starts_at_the_solve_size(frames):
     values = dict(config.DEFAULTS, window=8, stride=3, min_frames=3, scale=1.0,
-                  solve_pixels=24 * 32, solve_scale=1.0)
+                  solve_pixels=24 * 32, solve_scale=1.0, warm_start=True)
     detector = config.build_detector(config.validate(values))
     models = []
     for frame in frames:
