@@ -63,6 +63,7 @@ GRID = {
     'warm_start': (False, True),
     'absorb_frames': (2700, 5400, 10800),
     'moving_texture_k': (1.5, 2.0, 3.0),
+    'moving_texture_bits': (8, 12, 16),
     'texture_bits': (6, 8, 10),
     'mrf_beta': (1.0, 2.0, 3.0),
 }
