@@ -158,7 +158,7 @@ class SlidingWindowDetector(StreamingDetector):
         edge that the frame does not (a ghost joined to what is leaving it:
         :func:`~dgmod_ros.core.streaming.ghost.ghost_parts`); their pixels
         enter the window as they are, which heals the background.
-    still_frames : int, default=25
+    still_frames : int, default=15
         Drop pixels that have been in a still blob (at most 1 % of its pixels
         changed by more than ``pixel_k / 2`` noise levels against the frame
         5 frames before) for this many consecutive frames; they enter the
@@ -257,7 +257,7 @@ class SlidingWindowDetector(StreamingDetector):
                  global_change_fraction=0.7, memory_spacing=10, memory_columns=10,
                  conditional_update=True, hold_changes=False, absorb_frames=5400,
                  decision='adaptive', noise_source='solve', pixel_k=6.0, median_size=5,
-                 ghost_test=True, still_frames=25, mrf_beta=2.0, chroma_cue=True,
+                 ghost_test=True, still_frames=15, mrf_beta=2.0, chroma_cue=True,
                  texture_cue=True, texture_bits=8, moving_texture_k=2.0, moving_texture_bits=16,
                  solve_lag=5, solve_pixels=19200, solve_scale=0.5, warm_start=False,
                  refit_background=True):
