@@ -177,7 +177,8 @@ def conditional_columns(columns, background, foreground, foreground_age, absorb_
     Parameters
     ----------
     columns, background : ndarray (C, n)
-        The frame and its background at the processing size.
+        The frame and what goes in place of its foreground (its background
+        fit without that foreground) at the processing size.
     foreground : ndarray (n,) bool
         The frame's foreground at the processing size (already dilated by the caller).
     foreground_age : ndarray (n,) int

@@ -116,8 +116,10 @@ class SlidingWindowDetector(StreamingDetector):
         outvote them (``docs/results.md``).
     conditional_update : bool, default=True
         Admit a frame with its foreground (the mask, dilated by 5 x 5 at the
-        processing size) replaced by the background, so that a person who
-        stops is not learned into the background. While the window fills,
+        processing size) replaced by the background, the frame's projection
+        on the basis fit without that foreground (fit with it, it takes in
+        part of the person), so that a person who stops is not learned into
+        the background. While the window fills,
         frames go in as they are and their foreground is only left out of
         the noise levels.
     hold_changes : bool, default=False
@@ -604,6 +606,7 @@ class SlidingWindowDetector(StreamingDetector):
                 or self.buffer_.is_motionless(columns, self.motion_threshold)):
             return False
         observed = None
+        frame = columns
         if self.moving_ is not None:
             # What moves now is no evidence of the background: the window
             # takes the pixel's newest settled value there instead.
@@ -619,6 +622,15 @@ class SlidingWindowDetector(StreamingDetector):
                 held = self._held(foreground, still)
             # Dilated: a silhouette's border is foreground below the threshold.
             grown = cv2.dilate(held, _BORDER_KERNEL).ravel() > 0
+            if replace:
+                # In place of the foreground, the frame's projection on the
+                # basis fit without it: fit to the whole frame the projection
+                # takes in part of what stands there, and a person who stops
+                # would seep into the window admission by admission; fit to
+                # the rest it still follows the light.
+                model = self.background_model_
+                background = robust_projection(model.basis, frame, fit_basis=model.fit_basis,
+                                               left_out=grown)
             columns, observed = conditional_columns(columns, background, grown,
                                                     self.foreground_age_, self.absorb_frames,
                                                     replace)
