@@ -303,13 +303,19 @@ def test_detector_solves_capped_and_warm_starts_at_the_solve_size(frames):
     assert detector.snapshot().solve_shape == (24, 32, 3)
 
 
+def _consecutive_window(frames, **values):
+    """Return a detector of an 8-frame window of consecutive frames, ``frames`` processed."""
+    values = dict(config.DEFAULTS, window=8, stride=3, min_frames=3, memory_spacing=1, **values)
+    detector = config.build_detector(config.validate(values))
+    for frame in frames:
+        detector.process(frame)
+    return detector
+
+
 def test_a_solve_starts_from_its_window_unless_asked_to_warm_start(frames):
     # The iterates of earlier solves are no part of the window: by default a
     # solve reads nothing of the previous model; warm_start starts it there.
-    values = dict(config.DEFAULTS, window=8, stride=3, min_frames=3, memory_spacing=1)
-    detector = config.build_detector(config.validate(values))
-    for frame in frames[:20]:
-        detector.process(frame)
+    detector = _consecutive_window(frames[:20])
     snapshot = detector.snapshot()
     assert snapshot.previous is not None and not snapshot.warm_start
     alone = solve_window(replace(snapshot, previous=None))
@@ -322,10 +328,7 @@ def test_a_snapshot_holds_its_window_while_frames_go_on(frames):
     # The snapshot hands the solve the buffered columns, stacked in the solve's
     # thread: frames admitted after it (conditionally, the oldest dropped)
     # must not reach its window.
-    values = dict(config.DEFAULTS, window=8, stride=3, min_frames=3, memory_spacing=1)
-    detector = config.build_detector(config.validate(values))
-    for frame in frames[:12]:
-        detector.process(frame)
+    detector = _consecutive_window(frames[:12])
     snapshot = detector.snapshot()
     expected = np.stack(detector.buffer_.columns(), axis=2).copy()
     for frame in frames[12:30]:
@@ -340,12 +343,7 @@ def test_a_snapshot_holds_its_window_while_frames_go_on(frames):
 
 def _detector_snapshot(frames):
     """Return a snapshot of buffered columns, downscaled and refit as at the defaults."""
-    values = dict(config.DEFAULTS, window=8, stride=3, min_frames=3, memory_spacing=1,
-                  scale=1.0)
-    detector = config.build_detector(config.validate(values))
-    for frame in frames[:14]:
-        detector.process(frame)
-    snapshot = detector.snapshot()
+    snapshot = _consecutive_window(frames[:14], scale=1.0).snapshot()
     assert snapshot.solve_shape != snapshot.shape and snapshot.refit_background
     return snapshot
 
