@@ -4,8 +4,10 @@
 Cost of one window solve of a 640 x 480 camera: the defaults, ``scale:=1.0`` capped and uncapped.
 
 Builds each case's window from the same synthetic 640 x 480 colour scene at
-its processing size (the defaults: 320 x 240, solved at 160 x 120 and
-refit; the defaults before 2026-12-01: 320 x 240 solved as it is, no refit;
+its processing size (the defaults: 184 x 138 by ``processing_pixels``,
+solved at 92 x 69 and refit; ``scale`` 0.5 without that cap, the defaults
+before 2026-12-04: 320 x 240, solved at 160 x 120 and refit; the defaults
+before 2026-12-01: 320 x 240 solved as it is, no refit;
 ``scale=1.0``: 640 x 480, solved at ``solve_pixels`` and carried back;
 ``scale=1.0`` uncapped: solved at 640 x 480; the defaults with 5 sweeps
 per solve, the count before 2026-12-01), solves it once cold, then
@@ -36,12 +38,15 @@ from dgmod_ros.core.streaming.solve_resolution import solve_shape
 from dgmod_ros.core.synthetic import synthetic_scene
 import numpy as np
 
-CASES = (('defaults (scale 0.5)', {}),
-         ('scale=1.0, capped', {'scale': 1.0}),
+# Every case but the defaults lifts processing_pixels: they are the sizes compared before it.
+_UNCAPPED = {'processing_pixels': 640 * 480}
+CASES = (('defaults (184 x 138)', {}),
+         ('scale=1.0, capped', {'scale': 1.0, **_UNCAPPED}),
          ('defaults before', {'solve_scale': 1.0, 'refit_background': False,
-                              'solve_pixels': 320 * 240}),
+                              'solve_pixels': 320 * 240, **_UNCAPPED}),
          ('scale=1.0, uncapped', {'scale': 1.0, 'solve_scale': 1.0,
-                                  'solve_pixels': 640 * 480}),
+                                  'solve_pixels': 640 * 480, **_UNCAPPED}),
+         ('scale 0.5 without processing_pixels', dict(_UNCAPPED)),
          ('defaults, 5 sweeps', {'stream_max_iter': 5}))
 # The case whose stages are timed: the capped full-resolution solve.
 TIMED = 1
@@ -52,7 +57,8 @@ def snapshots(values, frames):
     detector = config.build_detector(dict(config.DEFAULTS, **values))
     width = int(detector.window)
     detector.validate()._build_helpers()             # the estimator and the mask rule
-    converted = [frame_columns(f, detector.scale, detector.color, 'rgb', None)
+    converted = [frame_columns(f, detector.scale, detector.color, 'rgb', None,
+                               int(detector.processing_pixels))
                  for f in frames[:width + 1]]
     columns, shape = [c for c, _ in converted], converted[0][1]
 

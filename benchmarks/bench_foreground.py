@@ -52,7 +52,13 @@ def main():
     model = detector.background_model_
     shape = detector.shape_
     k, stride = detector.pixel_k, detector.stride
-    columns, _ = frame_columns(frame, detector.scale, detector.color, 'rgb', None)
+
+    def columns_of(image, color=detector.color, order='rgb'):
+        # The detector's conversion: its scale and processing_pixels.
+        return frame_columns(image, detector.scale, color, order, None,
+                             int(detector.processing_pixels))[0]
+
+    columns = columns_of(frame)
     background = robust_projection(model.basis, columns)
     lighting, chroma_level = detector.lighting_, model.chroma_noise
     mask, distance = adaptive_mask(columns, background, model.noise, k, shape,
@@ -69,8 +75,7 @@ def main():
     age = detector.foreground_age_
     kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (5, 5))
     stages = {
-        'frame to columns (resize, colour)': lambda: frame_columns(
-            frame, detector.scale, detector.color, 'rgb', None),
+        'frame to columns (resize, colour)': lambda: columns_of(frame),
         'IRLS projection on the basis': lambda: robust_projection(model.basis, columns),
         'decision (per-pixel k sigma, Potts field)': lambda: adaptive_mask(
             columns, background, model.noise, k, shape, detector.median_size,
@@ -112,12 +117,11 @@ def main():
           'ms per frame')
     # Decoded files and bgr8 messages come in OpenCV's channel order.
     bgr = np.ascontiguousarray(frame[:, :, ::-1])
-    bgr_ms = median_ms(lambda: frame_columns(bgr, detector.scale, detector.color, 'bgr', None),
-                       args.repeats)
+    bgr_ms = median_ms(lambda: columns_of(bgr, order='bgr'), args.repeats)
     print(f'  {"frame to columns, BGR input (decoded files)":45s} {bgr_ms:7.2f} ms per frame')
     # The earlier default per-frame path in the same run, as the reference
     # (grey projection on one channel's basis, one threshold, 3 x 3 morphology).
-    grey, _ = frame_columns(frame, detector.scale, 'gray', 'rgb', None)
+    grey = columns_of(frame, color='gray')
     rule = detector.mask_rule_
     # A model solved for the per-pixel decision carries no global threshold;
     # the detector's own fallback gives one from the noise levels.

@@ -8,9 +8,11 @@ publishes the synthetic scene at 30 frames/s (sensor-data QoS, as drivers
 do), and in turn three receivers run as their own processes, started while the
 camera already publishes: a do-nothing node that answers every image with an
 empty mask (what the transport delivers), the detector at its defaults, and
-the detector at ``scale:=1.0`` (full resolution; its window solve capped at
-``solve_pixels``), and on request the detector at ``scale:=1.0`` with an
-uncapped, full-size solve (``full-solve``). Every process gets the
+the detector at ``scale:=1.0`` (full resolution; ``processing_pixels``
+lifted, its window solve capped at ``solve_pixels``), and on request the
+detector at ``scale`` 0.5 without the ``processing_pixels`` cap (``half``:
+the defaults before 2026-12-04, 320 x 240 for a 640 x 480 camera) and at
+``scale:=1.0`` with an uncapped, full-size solve (``full-solve``). Every process gets the
 package's Fast DDS profile (``config/fastdds_large_images.xml``) through
 ``FASTRTPS_DEFAULT_PROFILES_FILE`` unless ``--no-profile``.
 
@@ -25,7 +27,7 @@ readings swing by tens of MB, a leak raises the second peak). The issue asks
 for 60 s runs; ``--seconds`` defaults to 20 for a quick look.
 
 Usage (repo root): PYTHONPATH=. python benchmarks/bench_node.py [--seconds 60]
-    [--sizes 320x240,640x480] [--receivers null,defaults,full,full-solve] [--no-profile]
+    [--sizes 320x240,640x480] [--receivers null,defaults,half,full,full-solve] [--no-profile]
 """
 
 import argparse
@@ -38,11 +40,14 @@ import time
 
 REPO = Path(__file__).resolve().parents[1]
 PROFILE = REPO / 'config' / 'fastdds_large_images.xml'
+# Every receiver but the defaults lifts processing_pixels, which would cap them to the defaults.
+_UNCAPPED = 'processing_pixels:=100000000'
 RECEIVERS = {'null': ('do-nothing node', 'null', []),
              'defaults': ('detector, defaults', 'detector', []),
-             'full': ('detector, scale:=1.0', 'detector', ['scale:=1.0']),
+             'half': ('detector, scale 0.5 uncapped', 'detector', [_UNCAPPED]),
+             'full': ('detector, scale:=1.0', 'detector', ['scale:=1.0', _UNCAPPED]),
              'full-solve': ('scale:=1.0, uncapped solve', 'detector',
-                            ['scale:=1.0', 'solve_pixels:=100000000'])}
+                            ['scale:=1.0', 'solve_pixels:=100000000', _UNCAPPED])}
 
 
 def resident_mb():

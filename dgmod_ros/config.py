@@ -145,8 +145,15 @@ PARAMETERS = (
               acts=EVERYWHERE),
     Parameter('stride', 10, 'buffered frames between window solves (<= window)', 1, 300),
     Parameter('scale', 0.5, 'processing scale of frames for the per-frame path (projection, '
-              'decision) and the window; masks come back at input size. The window solve runs '
-              'at this scale up to solve_pixels', 0.05, 1.0, acts=EVERYWHERE),
+              'decision) and the window, up to processing_pixels; masks come back at input '
+              'size. The window solve runs at this size up to solve_pixels', 0.05, 1.0,
+              acts=EVERYWHERE),
+    Parameter('processing_pixels', 25600, 'largest frame (pixels) the per-frame path and the '
+              'window run at: a larger one (after scale) is scaled down to this, same aspect, '
+              'so that the per-frame rules, which reach over a fixed number of pixels, see a '
+              'scene alike at any camera resolution (25600: the largest processing size the '
+              'defaults were chosen at; a 640 x 480 camera runs at 184 x 138)', 64, 100000000,
+              acts=EVERYWHERE, advanced=True),
     Parameter('color', 'rgb', 'gray: one luma channel; rgb: each channel solved, fused by '
               'the largest magnitude', choices=_choices(SlidingWindowDetector, 'color'),
               acts=EVERYWHERE),
@@ -227,7 +234,7 @@ PARAMETERS = (
     Parameter('solve_pixels', 19200, 'largest frame (pixels) the window solve runs at: a '
               'larger one (after solve_scale) is solved scaled down to this, same aspect, and '
               "its full-size background fit from the solve's temporal factors (19200 = 160 x "
-              '120, a 640 x 480 camera at the default scale and solve_scale)', 64, 100000000,
+              '120: binds only where processing_pixels is raised above 320 x 240)', 64, 100000000,
               active_when=_WINDOW, advanced=True),
     Parameter('solve_scale', 0.5, 'scale of the window solve against the processing size '
               '(before the solve_pixels cap); the full-size background is fit from the '
@@ -577,10 +584,12 @@ def load_kernels(values, log=None, pending=None, should_stop=None):
 def detector_settings(values):
     """Return the keyword arguments of the streaming detector the values describe."""
     if detector_class(values) is OpenCVSubtractor:
-        return {'kind': values['method'], 'scale': values['scale'], 'color': values['color'],
+        return {'kind': values['method'], 'scale': values['scale'],
+                'processing_pixels': values['processing_pixels'], 'color': values['color'],
                 'morph_size': values['morph_size'], 'stride': values['stride']}
     return {'model': window_model(values, streaming=True), 'window': values['window'],
-            'stride': values['stride'], 'scale': values['scale'], 'color': values['color'],
+            'stride': values['stride'], 'scale': values['scale'],
+            'processing_pixels': values['processing_pixels'], 'color': values['color'],
             'mask_rule': build_mask_rule(values),
             'motion_threshold': values['motion_threshold'],
             'min_frames': values['min_frames'], 'basis_rank': values['basis_rank'],

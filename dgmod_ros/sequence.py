@@ -54,7 +54,8 @@ def batch_results(frames, values):
     separated = batch_separate(
         [f.image for f in frames], config.window_model(values), window=values['window'],
         scale=values['scale'], color=values['color'], mask_rule=config.build_mask_rule(values),
-        channel_order=frames[0].channel_order, value_range=values['value_range'] or None)
+        channel_order=frames[0].channel_order, value_range=values['value_range'] or None,
+        processing_pixels=values['processing_pixels'])
     for index, mask, background, record in separated:
         frame = frames[index]
         window = None

@@ -43,7 +43,7 @@ def window_tiles(count, window):
 
 
 def batch_separate(frames, model, window=60, scale=0.5, color='gray', mask_rule=None,
-                   channel_order='rgb', value_range=None):
+                   channel_order='rgb', value_range=None, processing_pixels=None):
     """
     Separate a sequence window by window, each frame masked by its whole window.
 
@@ -66,6 +66,8 @@ def batch_separate(frames, model, window=60, scale=0.5, color='gray', mask_rule=
         Channel order of colour frames.
     value_range : float or None
         Full-scale pixel value; None uses the dtype's.
+    processing_pixels : int or None
+        Largest processing size (pixels) after ``scale``; None: no limit.
 
     Yields
     ------
@@ -90,7 +92,8 @@ def batch_separate(frames, model, window=60, scale=0.5, color='gray', mask_rule=
             if np.asarray(frame).shape[:2] != input_shape:
                 raise ValueError(f'frame size changed from {input_shape} to '
                                  f'{np.asarray(frame).shape[:2]}')
-            frame_data, shape = frame_columns(frame, scale, color, channel_order, value_range)
+            frame_data, shape = frame_columns(frame, scale, color, channel_order, value_range,
+                                              processing_pixels)
             columns.append(frame_data)
         data = np.stack(columns, axis=2)                            # (C, n, m)
         rows, cols = shape[:2]

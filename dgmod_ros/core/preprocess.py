@@ -2,6 +2,8 @@
 # Licensed under the Apache License, Version 2.0
 """Frame preprocessing: grey or colour channels, [0, 1] scaling, downscaling, still frames."""
 
+import math
+
 import cv2
 import numpy as np
 
@@ -76,12 +78,23 @@ def to_uint8(image):
     return np.clip(np.asarray(image) * 255.0 + 0.5, 0, 255).astype(np.uint8)
 
 
-def processing_shape(frame_shape, scale):
-    """(rows, cols) of a frame after downscaling by ``scale`` (at least 1 x 1)."""
+def processing_shape(frame_shape, scale, max_pixels=None):
+    """
+    Return the (rows, cols) of a frame after downscaling by ``scale`` (at least 1 x 1).
+
+    With ``max_pixels``, a frame that has more pixels than that after
+    ``scale`` is scaled down further, by one factor in both directions, to
+    at most ``max_pixels`` (the camera's aspect kept).
+    """
     if not 0 < scale <= 1:
         raise ValueError(f'scale must be in (0, 1], got {scale!r}')
     rows, cols = frame_shape[:2]
-    return max(1, int(round(rows * scale))), max(1, int(round(cols * scale)))
+    small = max(1, int(round(rows * scale))), max(1, int(round(cols * scale)))
+    if max_pixels is None or small[0] * small[1] <= max_pixels:
+        return small
+    factor = math.sqrt(max_pixels / (rows * cols))
+    # The small epsilon keeps an exact factor (0.25 of 640 x 480 for 160 x 120) exact.
+    return max(1, int(rows * factor + 1e-6)), max(1, int(cols * factor + 1e-6))
 
 
 def resize(image, shape, interpolation=cv2.INTER_AREA):
@@ -92,12 +105,14 @@ def resize(image, shape, interpolation=cv2.INTER_AREA):
     return out.reshape(shape + image.shape[2:]) if image.ndim == 3 else out
 
 
-def frame_columns(frame, scale, color='gray', channel_order='rgb', value_range=None):
+def frame_columns(frame, scale, color='gray', channel_order='rgb', value_range=None,
+                  max_pixels=None):
     """
     Return one frame as per-channel pixel columns at the processing size.
 
     The one conversion every window method uses (streaming and batch):
-    :func:`to_float_channels`, then :func:`resize` to :func:`processing_shape`.
+    :func:`to_float_channels`, then :func:`resize` to :func:`processing_shape`
+    (``scale``, at most ``max_pixels`` pixels).
 
     Returns
     -------
@@ -109,7 +124,7 @@ def frame_columns(frame, scale, color='gray', channel_order='rgb', value_range=N
     frame = np.asarray(frame)
     if frame.ndim < 2 or frame.shape[0] == 0 or frame.shape[1] == 0:
         raise ValueError(f'frame must be a non-empty image, got shape {frame.shape}')
-    rows, cols = processing_shape(frame.shape[:2], scale)
+    rows, cols = processing_shape(frame.shape[:2], scale, max_pixels)
     if (color == 'rgb' and frame.ndim == 3 and frame.shape[2] in (3, 4)
             and frame.dtype in (np.uint8, np.uint16) and frame.shape[:2] == (2 * rows, 2 * cols)
             and channel_order in ('rgb', 'bgr')):

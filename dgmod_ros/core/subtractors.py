@@ -37,6 +37,8 @@ class OpenCVSubtractor(StreamingDetector):
         Which subtractor.
     scale : float, default=0.5
         Processing scale.
+    processing_pixels : int, default=25600
+        Largest processing size (pixels), as the window detector's.
     color : {'gray', 'rgb'}, default='gray'
         Feed luma or the three colour channels.
     morph_size : int, default=3
@@ -56,12 +58,15 @@ class OpenCVSubtractor(StreamingDetector):
 
     """
 
-    _parameter_constraints = {'kind': [Options(*_FACTORIES)], 'scale': SCALE, 'color': COLOR,
+    _parameter_constraints = {'kind': [Options(*_FACTORIES)], 'scale': SCALE,
+                              'processing_pixels': POSITIVE_INTEGER, 'color': COLOR,
                               'morph_size': NON_NEGATIVE_INTEGER, 'stride': POSITIVE_INTEGER}
 
-    def __init__(self, kind='mog2', scale=0.5, color='gray', morph_size=3, stride=10):
+    def __init__(self, kind='mog2', scale=0.5, processing_pixels=25600, color='gray',
+                 morph_size=3, stride=10):
         self.kind = kind
         self.scale = scale
+        self.processing_pixels = processing_pixels
         self.color = color
         self.morph_size = morph_size
         self.stride = stride
@@ -98,7 +103,8 @@ class OpenCVSubtractor(StreamingDetector):
         if reset:
             self.reset()
         self.input_shape_ = frame.shape[:2]
-        small = resize(channels, processing_shape(frame.shape[:2], self.scale))
+        small = resize(channels, processing_shape(frame.shape[:2], self.scale,
+                                                  int(self.processing_pixels)))
         image = to_uint8(small)
         if image.ndim == 3 and image.shape[2] == 3:
             image = cv2.cvtColor(image, cv2.COLOR_RGB2BGR)

@@ -23,6 +23,7 @@ WINDOW_CONSTRAINTS = {
     'window': [Interval(Integral, 2, None)],
     'stride': [Interval(Integral, 1, 'window')],
     'scale': SCALE,
+    'processing_pixels': POSITIVE_INTEGER,
     'color': COLOR,
     'motion_threshold': NON_NEGATIVE,
     'min_frames': [Interval(Integral, 2, 'window')],

@@ -75,8 +75,19 @@ class SlidingWindowDetector(StreamingDetector):
         Frames between solves.
     scale : float, default=0.5
         Processing scale in (0, 1] of the per-frame path (projection,
-        decision, the buffered window); masks come back at the input size.
-        The window solve runs at this scale too, up to ``solve_pixels``.
+        decision, the buffered window), up to ``processing_pixels``; masks
+        come back at the input size. The window solve runs at this size
+        too, up to ``solve_pixels``.
+    processing_pixels : int, default=25600
+        Largest frame (pixels) the per-frame path runs at: a larger one
+        (after ``scale``) is scaled down to at most this many pixels, same
+        aspect. The per-frame rules reach over neighbourhoods of a fixed
+        number of processing pixels (the median and the Potts field's 5 x
+        5, the texture's patches, the border kept out of the window), so a
+        scene means the same to them whatever the camera's resolution; the
+        default is the largest processing size of the sequences the
+        defaults were chosen on (352 x 288 at ``scale`` 0.5), so a 640 x
+        480 camera runs at 184 x 138 (``docs/results.md``).
     color : {'gray', 'rgb'}, default='rgb'
         'rgb' solves each channel and fuses the magnitudes by their maximum.
     mask_rule : MaskRule or None
@@ -211,9 +222,9 @@ class SlidingWindowDetector(StreamingDetector):
         (after ``solve_scale``) is scaled down to at most this many pixels,
         same aspect, and the full-size background carried from the solve's
         temporal factors (:mod:`~dgmod_ros.core.streaming.solve_resolution`);
-        the default is 160 x 120, the solve of a 640 x 480 camera at the
-        default ``scale`` and ``solve_scale``, so that larger cameras and
-        ``scale`` 1 cost about the same solve.
+        the default, 160 x 120, binds only where ``processing_pixels`` is
+        raised above 76800 (a processing size of 320 x 240 at the default
+        ``solve_scale``), so that such a size costs about the same solve.
     solve_scale : float, default=0.5
         Scale in (0, 1] of the window solve against the processing size
         (before the ``solve_pixels`` cap): the solve fixes the background's
@@ -254,7 +265,8 @@ class SlidingWindowDetector(StreamingDetector):
 
     _parameter_constraints = WINDOW_CONSTRAINTS
 
-    def __init__(self, model=None, window=30, stride=10, scale=0.5, color='rgb',
+    def __init__(self, model=None, window=30, stride=10, scale=0.5, processing_pixels=25600,
+                 color='rgb',
                  mask_rule=None, motion_threshold=0.0, min_frames=5, basis_rank=2,
                  global_change_fraction=0.7, memory_spacing=10, memory_columns=10,
                  conditional_update=True, hold_changes=False, absorb_frames=5400,
@@ -267,6 +279,7 @@ class SlidingWindowDetector(StreamingDetector):
         self.window = window
         self.stride = stride
         self.scale = scale
+        self.processing_pixels = processing_pixels
         self.color = color
         self.mask_rule = mask_rule
         self.motion_threshold = motion_threshold
@@ -328,11 +341,12 @@ class SlidingWindowDetector(StreamingDetector):
 
         The whole change is validated first; on ``ValueError`` nothing changes.
         Solves in flight are discarded when they come back; a new estimator
-        class starts cold. A new ``window``
-        keeps the newest frames; a new ``scale`` resamples the buffered frames
-        and drops the background model until the next solve, which is then
-        due at once; a new ``color`` restarts the window (grey frames cannot
-        become colour); model and mask parameters take effect at the next solve.
+        class starts cold. A new ``window`` keeps the newest frames; a new
+        processing size (``scale``, ``processing_pixels``) resamples the
+        buffered frames and drops the background model until the next solve,
+        which is then due at once; a new ``color`` restarts the window (grey
+        frames cannot become colour); model and mask parameters take effect
+        at the next solve.
         """
         old = assign_validated(self, params)
         if not hasattr(self, 'buffer_'):
@@ -347,10 +361,11 @@ class SlidingWindowDetector(StreamingDetector):
             return self
         self.buffer_.resize(int(self.window), int(self.memory_columns))
         self.buffer_.spacing = int(self.memory_spacing)
-        if ('scale' in params and params['scale'] != old['scale']
-                and self.input_shape_ is not None):
-            rows, cols = processing_shape(self.input_shape_, self.scale)
-            shape = (rows, cols, self.shape_[2])
+        if self.input_shape_ is None:
+            return self
+        rows, cols = processing_shape(self.input_shape_, self.scale, int(self.processing_pixels))
+        shape = (rows, cols, self.shape_[2])
+        if shape != self.shape_:
             self.buffer_.rescale(self.shape_, shape)
             self.shape_ = shape
             self.background_model_ = None
@@ -394,7 +409,7 @@ class SlidingWindowDetector(StreamingDetector):
     def _ingest(self, frame, channel_order, value_range):
         self._ensure_started()
         columns, shape = frame_columns(frame, self.scale, self.color, channel_order,
-                                       value_range)
+                                       value_range, int(self.processing_pixels))
         input_shape = np.shape(frame)[:2]
         reset = self.shape_ is not None and (shape != self.shape_
                                              or input_shape != self.input_shape_)
