@@ -266,8 +266,7 @@ class SlidingWindowDetector(StreamingDetector):
     _parameter_constraints = WINDOW_CONSTRAINTS
 
     def __init__(self, model=None, window=30, stride=10, scale=0.5, processing_pixels=25600,
-                 color='rgb',
-                 mask_rule=None, motion_threshold=0.0, min_frames=5, basis_rank=2,
+                 color='rgb', mask_rule=None, motion_threshold=0.0, min_frames=5, basis_rank=2,
                  global_change_fraction=0.7, memory_spacing=10, memory_columns=10,
                  conditional_update=True, hold_changes=False, absorb_frames=5400,
                  decision='adaptive', noise_source='solve', pixel_k=6.0, median_size=5,
