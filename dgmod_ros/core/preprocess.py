@@ -78,6 +78,20 @@ def to_uint8(image):
     return np.clip(np.asarray(image) * 255.0 + 0.5, 0, 255).astype(np.uint8)
 
 
+def shape_within(rows, cols, max_pixels):
+    """
+    Return (rows, cols) scaled down by one factor in both directions to at most ``max_pixels``.
+
+    A frame of at most ``max_pixels`` pixels keeps its size; at least 1 x 1.
+    The camera's aspect is kept.
+    """
+    if rows * cols <= max_pixels:
+        return rows, cols
+    factor = math.sqrt(max_pixels / (rows * cols))
+    # The small epsilon keeps an exact factor (0.25 of 640 x 480 for 160 x 120) exact.
+    return max(1, int(rows * factor + 1e-6)), max(1, int(cols * factor + 1e-6))
+
+
 def processing_shape(frame_shape, scale, max_pixels=None):
     """
     Return the (rows, cols) of a frame after downscaling by ``scale`` (at least 1 x 1).
@@ -92,9 +106,7 @@ def processing_shape(frame_shape, scale, max_pixels=None):
     small = max(1, int(round(rows * scale))), max(1, int(round(cols * scale)))
     if max_pixels is None or small[0] * small[1] <= max_pixels:
         return small
-    factor = math.sqrt(max_pixels / (rows * cols))
-    # The small epsilon keeps an exact factor (0.25 of 640 x 480 for 160 x 120) exact.
-    return max(1, int(rows * factor + 1e-6)), max(1, int(cols * factor + 1e-6))
+    return shape_within(rows, cols, max_pixels)
 
 
 def resize(image, shape, interpolation=cv2.INTER_AREA):

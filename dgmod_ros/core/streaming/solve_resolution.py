@@ -25,6 +25,7 @@ from .fast_path import background_basis
 from .kernels.solve_resolution import normal_equations
 from .noise_levels import magnitude_noise
 from ..linalg import thin_svd
+from ..preprocess import shape_within
 
 # Most channels one cv2.resize call takes: OpenCV 5's CV_CN_MAX, and 4 for
 # area averaging at a ratio that is not an integer (an integer one takes all:
@@ -48,12 +49,7 @@ def solve_shape(shape, max_pixels, scale=1.0):
     """
     rows, cols = shape[:2]
     max_pixels = min(max_pixels, int(scale * scale * rows * cols + 1e-6))
-    if rows * cols <= max_pixels:
-        return tuple(shape)
-    factor = np.sqrt(max_pixels / (rows * cols))
-    # The small epsilon keeps an exact factor (0.5 of 640 x 480 for 320 x 240) exact.
-    small = (max(1, int(rows * factor + 1e-6)), max(1, int(cols * factor + 1e-6)))
-    return small + tuple(shape[2:])
+    return shape_within(rows, cols, max_pixels) + tuple(shape[2:])
 
 
 def resample_columns(columns, shape, new_shape, interpolation):
