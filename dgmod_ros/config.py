@@ -275,6 +275,10 @@ PARAMETERS = (
               'the blob was seen to come in (most of its pixels moved while foreground): '
               'ghosts that uncover texture; they heal the window; 0 = off', 0, 1000000,
               active_when=_PER_PIXEL),
+    Parameter('line_pixels', 25, 'a blob of at least this many processing pixels that holds '
+              'no 3 x 3 square of foreground is a line (the rim of a light that grew with the '
+              "exposure, a cable's shadow), not a body: it leaves the published mask (the "
+              'window still keeps it out); 0 = off', 0, 1000000, active_when=_PER_PIXEL),
     Parameter('mrf_beta', 2.0, 'coupling of 5 x 5 neighbours in the Potts field that decides '
               'the per-pixel mask (log-odds per neighbour, mean field); 0 = threshold and '
               'median filter (median_size)', 0.0, 100.0, active_when=_PER_PIXEL),
@@ -602,6 +606,7 @@ def detector_settings(values):
             'noise_source': values['noise_source'],
             'pixel_k': values['pixel_k'], 'median_size': values['median_size'],
             'ghost_test': values['ghost_test'], 'still_frames': values['still_frames'],
+            'line_pixels': values['line_pixels'],
             'mrf_beta': values['mrf_beta'], 'chroma_cue': values['chroma_cue'],
             'texture_cue': values['texture_cue'], 'texture_bits': values['texture_bits'],
             'moving_texture_k': values['moving_texture_k'],

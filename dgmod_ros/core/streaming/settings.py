@@ -37,6 +37,7 @@ WINDOW_CONSTRAINTS = {
     'pixel_k': POSITIVE,
     'median_size': [Interval(Integral, 1, None, odd=True)],
     'still_frames': NON_NEGATIVE_INTEGER,
+    'line_pixels': NON_NEGATIVE_INTEGER,
     'mrf_beta': NON_NEGATIVE,
     'texture_bits': TEXTURE_BITS,
     'moving_texture_k': NON_NEGATIVE,
