@@ -261,6 +261,9 @@ class DetectorNode(LifecycleNode):
                                           throttle_duration_sec=_WARN_PERIOD)
                 return
             background = detector.background_image() if result.new_background else None
+            if result.frame_id == 0:        # the first frame of a size or encoding
+                self.get_logger().info(node_parameters.processing_line(
+                    image.shape, encoding, detector.processing_size(), self._values))
         depth = self._depth
         held = depth is not None and depth.holds_mask(msg.header)
         if depth is not None:       # first: it may release masks held before this one

@@ -71,3 +71,16 @@ def configured_line(values, input_topic, depth):
             f"{input_topic or 'depth only'} "
             f"({values['input_transport']}), depth "
             f"{'on' if depth else 'off'}")
+
+
+def processing_line(image_shape, encoding, processing_size, values):
+    """
+    Return the log line of a first frame: its size and the size its masks are computed at.
+
+    The configured line names ``scale``; what a camera's frames are processed
+    at also depends on ``processing_pixels`` and is known only once a frame came.
+    """
+    rows, cols = processing_size
+    return (f'frames of {image_shape[1]} x {image_shape[0]} {encoding}: masks computed at '
+            f"{cols} x {rows} (scale {values['scale']}, processing_pixels "
+            f"{values['processing_pixels']})")

@@ -150,6 +150,34 @@ def test_frame_size_change_restarts_the_window(harness, scene):
     assert harness.node._detector.shape_[:2] == (30, 40)
 
 
+class _InfoLines:
+    """Stands in for the node's logger; keeps the info lines."""
+
+    def __init__(self, logger):
+        self.logger, self.lines = logger, []
+
+    def info(self, text, **kwargs):
+        self.lines.append(text)
+
+    def __getattr__(self, name):
+        return getattr(self.logger, name)
+
+
+def test_the_node_says_what_size_a_camera_is_processed_at(harness, monkeypatch):
+    # The configured line names scale; a VGA camera's frames are processed
+    # smaller still (processing_pixels), which only the first frame tells.
+    logger = _InfoLines(harness.node.get_logger())
+    monkeypatch.setattr(harness.node, 'get_logger', lambda: logger)
+    frame = np.zeros((480, 640, 3), dtype=np.uint8)
+    for index in range(2):
+        harness.send(image_message(frame, 'rgb8', stamp_ns=(index + 1) * 33_000_000),
+                     settle=True)
+    said = [line for line in logger.lines if 'masks computed at' in line]
+    assert said == ['frames of 640 x 480 rgb8: masks computed at 184 x 138 (scale 0.5, '
+                    'processing_pixels 25600)']
+    assert harness.node._detector.processing_size() == (138, 184)
+
+
 def test_overlay_is_off_by_default_and_published_when_asked(harness, scene):
     overlays = []
     harness.client.create_subscription(Image, 'foreground_overlay', overlays.append,

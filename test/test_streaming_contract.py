@@ -66,12 +66,14 @@ def test_push_solve_install_sequence(method, frames):
     detector = config.build_detector(_values(method))
     assert isinstance(detector, StreamingDetector)
     assert detector.background_image() is None          # nothing seen yet
+    assert detector.processing_size() is None
     installed, announced = 0, 0
     for frame_id, frame in enumerate(frames[:20]):
         result = detector.push(frame)
         _check_result(detector, result, frame_id)
         announced += result.new_background
         installed += _solve_when_due(detector) is not None
+    assert detector.processing_size() == (SHAPE[0] // 2, SHAPE[1] // 2)     # scale 0.5
     status = detector.status()
     assert set(status) == {'window_frames', 'model_ready', 'scene_changes'}
     assert status['model_ready']

@@ -80,6 +80,7 @@ class OpenCVSubtractor(StreamingDetector):
         self._new_generation()
         self.subtractor_ = _FACTORIES[self.kind]()
         self.input_shape_ = None
+        self.processing_shape_ = None
         self.next_id_ = 0
 
     def configure(self, **params):
@@ -103,8 +104,9 @@ class OpenCVSubtractor(StreamingDetector):
         if reset:
             self.reset()
         self.input_shape_ = frame.shape[:2]
-        small = resize(channels, processing_shape(frame.shape[:2], self.scale,
-                                                  int(self.processing_pixels)))
+        self.processing_shape_ = processing_shape(frame.shape[:2], self.scale,
+                                                  int(self.processing_pixels))
+        small = resize(channels, self.processing_shape_)
         image = to_uint8(small)
         if image.ndim == 3 and image.shape[2] == 3:
             image = cv2.cvtColor(image, cv2.COLOR_RGB2BGR)
@@ -132,6 +134,10 @@ class OpenCVSubtractor(StreamingDetector):
         rows, cols = self.input_shape_
         return cv2.resize(image, (cols, rows), interpolation=cv2.INTER_LINEAR).reshape(
             rows, cols, -1)
+
+    def processing_size(self):
+        """Return the (rows, cols) the subtractor runs at, or None before the first frame."""
+        return getattr(self, 'processing_shape_', None)
 
     def status(self):
         """Return the subtractor's figures for diagnostics (it has no window)."""

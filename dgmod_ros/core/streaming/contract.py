@@ -217,6 +217,10 @@ class StreamingDetector(ABC):
         """Return the current background, float [0, 1], (h, w, C) at the input size, or None."""
 
     @abstractmethod
+    def processing_size(self):
+        """Return the (rows, cols) the per-frame path runs at for the frames seen, or None."""
+
+    @abstractmethod
     def status(self):
         """
         Return a dict of figures for diagnostics.

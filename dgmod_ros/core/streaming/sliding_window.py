@@ -697,6 +697,11 @@ class SlidingWindowDetector(StreamingDetector):
                                 interpolation=cv2.INTER_LINEAR)
         return background.reshape(rows, cols, -1)
 
+    def processing_size(self):
+        """Return the (rows, cols) the per-frame path runs at, or None before the first frame."""
+        shape = getattr(self, 'shape_', None)
+        return None if shape is None else tuple(shape[:2])
+
     def status(self):
         """Return the window's figures for diagnostics."""
         self._ensure_started()
