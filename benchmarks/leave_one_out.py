@@ -58,7 +58,7 @@ from eval_sequences import DATA, score_dataset, SEQUENCES  # noqa: E402, I100
 GRID = {
     'pixel_k': (4.5, 6.0, 7.5),
     'still_frames': (10, 15, 25),
-    'line_pixels': (0, 9, 16, 25),
+    'line_pixels': (0, 36, 64, 100),
     'memory_spacing': (5, 10, 20),
     'memory_columns': (5, 10, 15),
     'warm_start': (False, True),

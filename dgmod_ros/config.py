@@ -275,10 +275,11 @@ PARAMETERS = (
               'the blob was seen to come in (most of its pixels moved while foreground): '
               'ghosts that uncover texture; they heal the window; 0 = off', 0, 1000000,
               active_when=_PER_PIXEL),
-    Parameter('line_pixels', 25, 'a blob of at least this many processing pixels that holds '
-              'no 3 x 3 square of foreground is a line (the rim of a light that grew with the '
-              "exposure, a cable's shadow), not a body: it leaves the published mask (the "
-              'window still keeps it out); 0 = off', 0, 1000000, active_when=_PER_PIXEL),
+    Parameter('line_pixels', 100, 'a blob with no 3 x 3 square of foreground at the '
+              'processing size is a line (the rim of a light that grew with the exposure, a '
+              "cable's shadow), not a body: one that covers at least this many of the camera's "
+              'pixels leaves the published mask (the window still keeps it out); 0 = off', 0,
+              100000000, active_when=_PER_PIXEL),
     Parameter('mrf_beta', 2.0, 'coupling of 5 x 5 neighbours in the Potts field that decides '
               'the per-pixel mask (log-odds per neighbour, mean field); 0 = threshold and '
               'median filter (median_size)', 0.0, 100.0, active_when=_PER_PIXEL),

@@ -3,7 +3,7 @@
 """Blobs that are lines, not bodies, leave the published mask and only it."""
 
 from dgmod_ros.core.streaming import SlidingWindowDetector
-from dgmod_ros.core.streaming.lines import without_lines
+from dgmod_ros.core.streaming.lines import processing_pixels_of, without_lines
 import numpy as np
 import pytest
 
@@ -48,6 +48,17 @@ def test_only_the_line_goes_and_the_input_is_left_as_it_was():
 def test_zero_keeps_every_blob():
     mask = _mask((5, 6, 10, 40))
     assert without_lines(mask, 0) is mask
+
+
+def test_the_size_of_an_obstacle_is_counted_in_the_cameras_pixels():
+    # 100 camera pixels are 25 processing pixels of a frame processed at half
+    # its size, and 8.3 of a 640 x 480 camera's frame processed at 184 x 138:
+    # there a coreless blob of 9 processing pixels is an obstacle-sized line.
+    assert processing_pixels_of(100, (120, 160), (240, 320)) == 25
+    vga = processing_pixels_of(100, (138, 184), (480, 640))
+    assert vga == pytest.approx(8.27, abs=0.01)
+    assert not without_lines(_mask((5, 6, 10, 19)), vga).any()
+    assert without_lines(_mask((5, 6, 10, 18)), vga).any()
 
 
 def _wall_then_line_and_box(frames=50, appear=40):

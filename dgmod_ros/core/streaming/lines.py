@@ -10,10 +10,12 @@ whole edge: each of its pixels is far from its background by many noise
 levels, and the Potts field keeps the band because its pixels back each
 other along it. A body is thick: at the processing size (a frame of at most
 ``processing_pixels``) even a far person holds a 3 x 3 square of foreground
-somewhere. A blob of at least ``min_pixels`` pixels that holds none is a
-line, and a planner given it would stop for a phantom. Smaller blobs are
-left alone: slivers of a person that the background half holds (a person who
-stood from the first frame, a far walker's limbs) are that size.
+somewhere. A blob that holds none is a line, and when it is large enough to
+be an obstacle to the planner it leaves the mask. Large enough is counted in
+the camera's pixels (:func:`processing_pixels_of`), which is what the
+planner receives: one point per pixel. Smaller blobs are left alone: slivers
+of a person that the background half holds (a person who stood from the
+first frame, a far walker's limbs) are that size.
 
 The rule only thins what is published. The window still keeps the line's
 pixels out (a limb cut off from its body must not be learnt as background);
@@ -27,6 +29,12 @@ import numpy as np
 _CORE = np.ones((3, 3), dtype=np.uint8)
 
 
+def processing_pixels_of(camera_pixels, processing_shape, input_shape):
+    """Return the processing pixels (float) a blob of ``camera_pixels`` input pixels covers."""
+    return (camera_pixels * float(processing_shape[0] * processing_shape[1])
+            / float(input_shape[0] * input_shape[1]))
+
+
 def without_lines(mask, min_pixels):
     """
     Return ``mask`` without its line blobs (a new array; ``mask`` itself when there are none).
@@ -35,7 +43,7 @@ def without_lines(mask, min_pixels):
     ----------
     mask : ndarray (rows, cols) uint8
         0/255 foreground at the processing size.
-    min_pixels : int
+    min_pixels : float
         Fewest pixels of an 8-connected blob that holds no 3 x 3 square of
         foreground for it to be a line; 0 keeps every blob.
 

@@ -21,7 +21,7 @@ from .fast_path import robust_projection
 from .ghost import ghost_labels, ghost_parts
 from .held_foreground import consecutive_frames, moved_inside, still_blob_pixels
 from .kernels.warmup_background import entry_medians
-from .lines import without_lines
+from .lines import processing_pixels_of, without_lines
 from .noise_levels import warmup_noise
 from .photometric import LightingTest
 from .results import FrameResult, WindowSnapshot
@@ -185,10 +185,11 @@ class SlidingWindowDetector(StreamingDetector):
         and the next solve starts from it
         (:meth:`~dgmod_ros.core.streaming.background_memory.BackgroundMemory.overwrite`).
         0 disables.
-    line_pixels : int, default=25
-        A blob of at least this many processing pixels that holds no 3 x 3
-        square of foreground is a line, not a body (the rim of a light that
-        grew with the exposure, a cable's shadow): it is left out of the
+    line_pixels : int, default=100
+        A blob that holds no 3 x 3 square of foreground at the processing
+        size is a line, not a body (the rim of a light that grew with the
+        exposure, a cable's shadow); one that covers at least this many of
+        the camera's pixels, an obstacle to a planner, is left out of the
         published mask but still kept out of the window
         (:mod:`~dgmod_ros.core.streaming.lines`; 'adaptive', 'uniform'). 0
         keeps every blob.
@@ -278,7 +279,7 @@ class SlidingWindowDetector(StreamingDetector):
                  global_change_fraction=0.7, memory_spacing=10, memory_columns=10,
                  conditional_update=True, hold_changes=False, absorb_frames=5400,
                  decision='adaptive', noise_source='solve', pixel_k=6.0, median_size=5,
-                 ghost_test=True, still_frames=15, line_pixels=25, mrf_beta=2.0,
+                 ghost_test=True, still_frames=15, line_pixels=100, mrf_beta=2.0,
                  chroma_cue=True, texture_cue=True, texture_bits=8, moving_texture_k=2.0,
                  moving_texture_bits=16, solve_lag=5, solve_pixels=19200, solve_scale=0.5,
                  warm_start=False, refit_background=True):
@@ -533,8 +534,8 @@ class SlidingWindowDetector(StreamingDetector):
                 and earlier is not None):
             self._blob_rules(foreground, columns, background, level, earlier, change, still)
         # Lines leave what is published only: the window keeps them out as foreground.
-        result.mask = to_input_size(without_lines(foreground, int(self.line_pixels)),
-                                    self.input_shape_)
+        line_size = processing_pixels_of(self.line_pixels, foreground.shape, self.input_shape_)
+        result.mask = to_input_size(without_lines(foreground, line_size), self.input_shape_)
         return foreground, changed
 
     def _blob_rules(self, foreground, columns, background, level, earlier, change, still):
