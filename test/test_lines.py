@@ -73,7 +73,7 @@ def _wall_then_line_and_box(frames=50, appear=40):
         yield np.clip(image, 0, 1)
 
 
-@pytest.mark.parametrize('line_pixels', [16, 0])
+@pytest.mark.parametrize('line_pixels', [100, 0])
 def test_the_detector_publishes_the_box_and_not_the_line(line_pixels):
     detector = SlidingWindowDetector(line_pixels=line_pixels)
     results = [detector.process(image)[0] for image in _wall_then_line_and_box()]
