@@ -48,6 +48,24 @@ def camera_info_message(k, shape, stamp_ns=0, frame_id='depth_optical'):
     return _stamp(msg, stamp_ns, frame_id)
 
 
+class RecordingLogger:
+    """Stands in for the node's logger; keeps the info lines and the warnings."""
+
+    def __init__(self, logger):
+        self.logger = logger
+        self.infos = []
+        self.warnings = []
+
+    def info(self, text, **kwargs):
+        self.infos.append(text)
+
+    def warning(self, text, **kwargs):
+        self.warnings.append(text)
+
+    def __getattr__(self, name):
+        return getattr(self.logger, name)
+
+
 class DetectorHarness:
     """
     The node under test plus a client node that publishes frames and collects outputs.

@@ -15,9 +15,8 @@ from dgmod_ros.transport import profile_path, PROFILE_VARIABLE
 import numpy as np
 import pytest
 from ros_harness import (camera_info_message, depth_message, DetectorHarness, image_message,
-                         mask_array)
+                         mask_array, RecordingLogger)
 from std_srvs.srv import Trigger
-from test_transport import RecordingLogger
 
 SHAPE = (120, 160)
 T0 = 1_700_000_000 * 10**9

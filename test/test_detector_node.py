@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile
-from ros_harness import DetectorHarness, image_message, mask_array
+from ros_harness import DetectorHarness, image_message, mask_array, RecordingLogger
 from sensor_msgs.msg import Image
 
 SHAPE = (120, 160)
@@ -150,29 +150,16 @@ def test_frame_size_change_restarts_the_window(harness, scene):
     assert harness.node._detector.shape_[:2] == (30, 40)
 
 
-class _InfoLines:
-    """Stands in for the node's logger; keeps the info lines."""
-
-    def __init__(self, logger):
-        self.logger, self.lines = logger, []
-
-    def info(self, text, **kwargs):
-        self.lines.append(text)
-
-    def __getattr__(self, name):
-        return getattr(self.logger, name)
-
-
 def test_the_node_says_what_size_a_camera_is_processed_at(harness, monkeypatch):
     # The configured line names scale; a VGA camera's frames are processed
     # smaller still (processing_pixels), which only the first frame tells.
-    logger = _InfoLines(harness.node.get_logger())
+    logger = RecordingLogger(harness.node.get_logger())
     monkeypatch.setattr(harness.node, 'get_logger', lambda: logger)
     frame = np.zeros((480, 640, 3), dtype=np.uint8)
     for index in range(2):
         harness.send(image_message(frame, 'rgb8', stamp_ns=(index + 1) * 33_000_000),
                      settle=True)
-    said = [line for line in logger.lines if 'masks computed at' in line]
+    said = [line for line in logger.infos if 'masks computed at' in line]
     assert said == ['frames of 640 x 480 rgb8: masks computed at 184 x 138 (scale 0.5, '
                     'processing_pixels 25600)']
     assert harness.node._detector.processing_size() == (138, 184)

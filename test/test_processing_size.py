@@ -41,9 +41,8 @@ def test_a_vga_camera_is_processed_at_the_capped_size_and_masked_at_its_own(dete
     for frame in scene.frames:
         result, _ = detector.process(frame)
         assert result.mask.shape == (480, 640)
-    if isinstance(detector, SlidingWindowDetector):
-        assert detector.shape_ == (138, 184, 3)
-        assert detector.background_image().shape == (480, 640, 3)
+    assert detector.processing_size() == (138, 184)
+    assert detector.background_image().shape == (480, 640, 3)
 
 
 def test_a_new_processing_size_resamples_the_window_and_an_unchanged_one_keeps_the_model():

@@ -7,7 +7,7 @@ import xml.etree.ElementTree as ElementTree
 
 from dgmod_ros.transport import LargeImageCheck, profile_path, PROFILE_VARIABLE
 import numpy as np
-from ros_harness import DetectorHarness, image_message
+from ros_harness import DetectorHarness, image_message, RecordingLogger
 
 VGA_RGB = 640 * 480 * 3
 REPO = Path(__file__).resolve().parents[1]
@@ -36,20 +36,6 @@ def test_the_profile_holds_five_720p_rgb_frames():
     assert sizes and min(sizes) >= 5 * 1280 * 720 * 3 * 1.2
     participant = root.find('.//p:participant', namespace)
     assert participant.get('is_default_profile') == 'true'
-
-
-class RecordingLogger:
-    """Stands in for the node's logger; keeps the warnings."""
-
-    def __init__(self, logger):
-        self.logger = logger
-        self.warnings = []
-
-    def warning(self, text, **kwargs):
-        self.warnings.append(text)
-
-    def __getattr__(self, name):
-        return getattr(self.logger, name)
 
 
 def test_the_node_warns_once_for_vga_frames(monkeypatch):
