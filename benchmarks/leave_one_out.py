@@ -59,6 +59,7 @@ GRID = {
     'pixel_k': (4.5, 6.0, 7.5),
     'still_frames': (10, 15, 25),
     'line_pixels': (0, 36, 64, 100),
+    'fill_holes': (False, True),
     'memory_spacing': (5, 10, 20),
     'memory_columns': (5, 10, 15),
     'warm_start': (False, True),

@@ -280,6 +280,10 @@ PARAMETERS = (
               "cable's shadow), not a body: one that covers at least this many of the camera's "
               'pixels leaves the published mask (the window still keeps it out); 0 = off', 0,
               100000000, active_when=_PER_PIXEL),
+    Parameter('fill_holes', True, "fill the published mask's holes: background that no path "
+              "through the background joins to the frame's edge, enclosed by a body's outline "
+              '(a flat coat whose colour the window has seen there); the window keeps the '
+              'unfilled decision', active_when=_PER_PIXEL),
     Parameter('mrf_beta', 2.0, 'coupling of 5 x 5 neighbours in the Potts field that decides '
               'the per-pixel mask (log-odds per neighbour, mean field); 0 = threshold and '
               'median filter (median_size)', 0.0, 100.0, active_when=_PER_PIXEL),
@@ -607,7 +611,7 @@ def detector_settings(values):
             'noise_source': values['noise_source'],
             'pixel_k': values['pixel_k'], 'median_size': values['median_size'],
             'ghost_test': values['ghost_test'], 'still_frames': values['still_frames'],
-            'line_pixels': values['line_pixels'],
+            'line_pixels': values['line_pixels'], 'fill_holes': values['fill_holes'],
             'mrf_beta': values['mrf_beta'], 'chroma_cue': values['chroma_cue'],
             'texture_cue': values['texture_cue'], 'texture_bits': values['texture_bits'],
             'moving_texture_k': values['moving_texture_k'],

@@ -20,6 +20,7 @@ from .decision import adaptive_mask
 from .fast_path import robust_projection
 from .ghost import ghost_labels, ghost_parts
 from .held_foreground import consecutive_frames, moved_inside, still_blob_pixels
+from .holes import filled_holes
 from .kernels.warmup_background import entry_medians
 from .lines import processing_pixels_of, without_lines
 from .noise_levels import warmup_noise
@@ -193,6 +194,12 @@ class SlidingWindowDetector(StreamingDetector):
         published mask but still kept out of the window
         (:mod:`~dgmod_ros.core.streaming.lines`; 'adaptive', 'uniform'). 0
         keeps every blob.
+    fill_holes : bool, default=True
+        Fill the holes of the published mask: background pixels that no path
+        through the background joins to the frame's edge, enclosed by a
+        body's outline (a flat coat whose colour the window has seen there;
+        :mod:`~dgmod_ros.core.streaming.holes`; 'adaptive', 'uniform'). The
+        window keeps the unfilled decision.
     mrf_beta : float, default=2.0
         > 0: the adaptive decision is a Potts field over the ``pixel_k``-sigma
         rule, coupling 5 x 5 neighbours with this weight (log-odds per
@@ -279,7 +286,8 @@ class SlidingWindowDetector(StreamingDetector):
                  global_change_fraction=0.7, memory_spacing=10, memory_columns=10,
                  conditional_update=True, hold_changes=False, absorb_frames=5400,
                  decision='adaptive', noise_source='solve', pixel_k=6.0, median_size=5,
-                 ghost_test=True, still_frames=15, line_pixels=100, mrf_beta=2.0,
+                 ghost_test=True, still_frames=15, line_pixels=100, fill_holes=True,
+                 mrf_beta=2.0,
                  chroma_cue=True, texture_cue=True, texture_bits=8, moving_texture_k=2.0,
                  moving_texture_bits=16, solve_lag=5, solve_pixels=19200, solve_scale=0.5,
                  warm_start=False, refit_background=True):
@@ -306,6 +314,7 @@ class SlidingWindowDetector(StreamingDetector):
         self.ghost_test = ghost_test
         self.still_frames = still_frames
         self.line_pixels = line_pixels
+        self.fill_holes = fill_holes
         self.mrf_beta = mrf_beta
         self.chroma_cue = chroma_cue
         self.texture_cue = texture_cue
@@ -533,9 +542,13 @@ class SlidingWindowDetector(StreamingDetector):
         if ((self.ghost_test or self.still_frames) and model is not None
                 and earlier is not None):
             self._blob_rules(foreground, columns, background, level, earlier, change, still)
-        # Lines leave what is published only: the window keeps them out as foreground.
+        # Lines leave, and holes join, what is published only: the window keeps
+        # its own decision. Lines first: a ring of rim filled would be a body.
         line_size = processing_pixels_of(self.line_pixels, foreground.shape, self.input_shape_)
-        result.mask = to_input_size(without_lines(foreground, line_size), self.input_shape_)
+        published = without_lines(foreground, line_size)
+        if self.fill_holes:
+            published = filled_holes(published)
+        result.mask = to_input_size(published, self.input_shape_)
         return foreground, changed
 
     def _blob_rules(self, foreground, columns, background, level, earlier, change, still):

@@ -1,0 +1,94 @@
+# Copyright 2026 dgmod_ros authors
+# Licensed under the Apache License, Version 2.0
+"""The published mask's holes are filled; what is open to the frame's edge is not."""
+
+from dgmod_ros.core.streaming import SlidingWindowDetector
+from dgmod_ros.core.streaming.holes import filled_holes
+import numpy as np
+import pytest
+
+
+def _ring(mask, top, bottom, left, right, width=1):
+    mask[top:bottom, left:right] = 255
+    mask[top + width:bottom - width, left + width:right - width] = 0
+    return mask
+
+
+def test_what_an_outline_encloses_is_filled():
+    mask = _ring(np.zeros((30, 40), np.uint8), 5, 20, 10, 30)
+    before = mask.copy()
+    filled = filled_holes(mask)
+    assert np.array_equal(mask, before)
+    assert filled[5:20, 10:30].all()
+    assert np.count_nonzero(filled) == 15 * 20
+
+
+def test_an_outline_joined_at_a_corner_only_still_encloses():
+    # A diamond of single pixels, each touching the next at a corner: one
+    # 8-connected blob, and its inside is no 4-connected path to the edge.
+    mask = np.zeros((21, 21), np.uint8)
+    for step in range(7):
+        for row, col in ((10 - step, 4 + step), (10 - step, 16 - step),
+                         (10 + step, 4 + step), (10 + step, 16 - step)):
+            mask[row, col] = 255
+    filled = filled_holes(mask)
+    assert filled[10, 10] == 255
+    assert filled[6:15, 10].all()
+    assert not filled[0].any() and not filled[:, 0].any()
+
+
+def test_a_body_cut_by_the_frames_edge_is_not_closed_along_it():
+    # A U open at the bottom edge: which side of it is the body is not known.
+    mask = np.zeros((30, 40), np.uint8)
+    mask[10:30, 10:13] = 255
+    mask[10:30, 27:30] = 255
+    mask[10:13, 10:30] = 255
+    assert filled_holes(mask) is mask
+
+
+def test_background_between_two_people_is_not_filled():
+    mask = np.zeros((30, 40), np.uint8)
+    mask[5:25, 5:12] = 255
+    mask[5:25, 20:27] = 255
+    assert filled_holes(mask) is mask
+
+
+def test_an_empty_mask_and_a_full_mask_are_their_own_filling():
+    empty = np.zeros((10, 10), np.uint8)
+    full = np.full((10, 10), 255, np.uint8)
+    assert filled_holes(empty) is empty
+    assert filled_holes(full) is full
+
+
+def _wall_then_ring(frames=50, appear=40):
+    """Yield a textured wall; from ``appear`` on, a bright ring round the wall (8 x 14 inside)."""
+    rng = np.random.default_rng(5)
+    wall = rng.uniform(0.3, 0.6, (48, 96, 3)).astype(np.float32)
+    for index in range(frames):
+        image = wall + rng.normal(0, 0.004, wall.shape).astype(np.float32)
+        if index >= appear:
+            image[10:42, 40:82] = 0.95          # 16 x 21 processing pixels
+            image[16:36, 46:76] = wall[16:36, 46:76]
+        yield np.clip(image, 0, 1)
+
+
+@pytest.mark.parametrize('fill_holes', [True, False])
+def test_the_detector_publishes_the_ring_whole_or_as_it_decided(fill_holes):
+    detector = SlidingWindowDetector(fill_holes=fill_holes)
+    results = [detector.process(image)[0] for image in _wall_then_ring()]
+    assert results[39].model_ready
+    for result in results[41:]:
+        assert result.mask[12:40, 42:80][:, [0, -1]].all()
+        inside = result.mask[20:32, 50:72].mean() / 255
+        assert inside == (1.0 if fill_holes else 0.0)
+
+
+def test_the_window_keeps_the_unfilled_decision():
+    # What the window admits is the decision before the fill: the wall inside
+    # the ring is background there, and the next solves learn it.
+    detector = SlidingWindowDetector()
+    for image in _wall_then_ring(frames=45):
+        detector.process(image)
+    foreground = detector.previous_foreground_.reshape(24, 48)
+    assert foreground[6:20, 21:40][:, [0, -1]].all()
+    assert not foreground[10:16, 25:36].any()
