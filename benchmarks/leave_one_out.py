@@ -60,6 +60,7 @@ GRID = {
     'still_frames': (10, 15, 25),
     'line_pixels': (0, 36, 64, 100),
     'fill_holes': (False, True),
+    'doubtful_floor': (0.0, 0.5, 1.0),
     'memory_spacing': (5, 10, 20),
     'memory_columns': (5, 10, 15),
     'warm_start': (False, True),

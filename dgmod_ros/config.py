@@ -266,6 +266,11 @@ PARAMETERS = (
               'decision thresholds); max: the larger of the solve and projection levels',
               choices=_choices(SlidingWindowDetector, 'noise_source'), active_when=_PER_PIXEL,
               advanced=True),
+    Parameter('doubtful_floor', 0.5, "a pixel the window's masks called foreground in more "
+              'than half of its columns (a person in view while the window filled) reads its '
+              'noise level from the differences of consecutive columns where that is lower '
+              'than the level of all its columns, but not below this share of it; 1 = the '
+              'level of all its columns', 0.0, 1.0, active_when=_PER_PIXEL),
     Parameter('ghost_test', True, 'drop still blobs, and still parts of blobs, whose outline '
               'is an edge of the background rather than of the frame (ghosts of what has '
               'left); they heal the window',
@@ -609,6 +614,7 @@ def detector_settings(values):
             'hold_changes': values['hold_changes'],
             'absorb_frames': values['absorb_frames'], 'decision': values['decision'],
             'noise_source': values['noise_source'],
+            'doubtful_floor': values['doubtful_floor'],
             'pixel_k': values['pixel_k'], 'median_size': values['median_size'],
             'ghost_test': values['ghost_test'], 'still_frames': values['still_frames'],
             'line_pixels': values['line_pixels'], 'fill_holes': values['fill_holes'],

@@ -623,3 +623,37 @@ def test_the_filling_window_admits_frames_as_they_are_without_their_foreground_i
     observed = observed[:, -1].reshape(30, 40)
     assert not observed[10:18, 25:31].any()              # the box: left out of the noise
     assert observed[25:, :].all()                        # the wall below it: counted
+
+
+def test_a_doubtful_pixel_that_changes_slowly_takes_the_level_of_its_differences():
+    # 10 columns. Top-left block: a person in view in 8 of them, which the
+    # masks called foreground, his clothes drifting 0.04 a column (their folds
+    # as he moves). Bottom-right block: leaves the masks called foreground in
+    # 8 columns too, flickering by 0.3 from one column to the next.
+    rows, cols, columns = 20, 20, 10
+    residual = _quiet_residual(rows, cols, columns)
+    observed = np.ones((rows * cols, columns), bool)
+    person = np.zeros((rows, cols), bool)
+    person[:6, :6] = True
+    leaves = np.zeros((rows, cols), bool)
+    leaves[14:, 14:] = True
+    residual[0, person.ravel()] += 0.04 * np.arange(columns, dtype=np.float32) - 0.18
+    residual[0, leaves.ravel()] += 0.3 * (np.arange(columns) % 2 - 0.5).astype(np.float32)
+    observed[(person | leaves).ravel(), :8] = False
+    shape = (rows, cols, 1)
+    whole, half, steps = (pixel_noise(residual, shape, observed, doubtful_floor=floor)
+                          .reshape(rows, cols) for floor in (1.0, 0.5, 0.0))
+    # The median over all columns counts the drift: about 1.4826 * 0.1.
+    assert whole[2, 2] > 0.12
+    # Consecutive differences see 0.04 a column: 1.4826 * 0.04 / sqrt(2).
+    assert steps[2, 2] == pytest.approx(1.4826 * 0.04 / np.sqrt(2), rel=0.25)
+    assert half[2, 2] == pytest.approx(0.5 * whole[2, 2], rel=0.05)
+    # The leaves' differences are twice their deviation: they keep their level
+    # (inside the block, where the 5 x 5 smoothing mixes in no quiet pixel).
+    assert np.array_equal(whole[16:, 16:], steps[16:, 16:])
+    assert whole[17, 17] > 0.2                            # 1.4826 * 0.15
+    # Pixels the masks called background in most columns are not doubtful.
+    assert np.array_equal(whole[:8, 9:], steps[:8, 9:])
+    # Without masks no pixel is doubtful: the floor changes nothing.
+    assert np.array_equal(pixel_noise(residual, shape, doubtful_floor=0.0),
+                          pixel_noise(residual, shape))

@@ -224,11 +224,11 @@ def test_command_line_writes_the_suite(material, data_dir, tmp_path, monkeypatch
 # (at this scale close_in_view is 45 frames, most of them while the window
 # still fills with consecutive frames: the figures are those of a first start).
 SCENARIO_FLOORS = {
-    'in_view': (0.47, 0.19),        # measured F 0.497, person recall 0.225
+    'in_view': (0.49, 0.27),        # measured F 0.524, person recall 0.308
     'stops': (0.96, 0.97),          # measured 0.995, 1.000
-    'close_up': (0.92, 0.97),       # measured 0.955, 1.000 (0.495, 0.176 with every fit whole)
+    'close_up': (0.92, 0.97),       # measured 0.959, 1.000 (0.495, 0.176 with every fit whole)
     'crossing': (0.96, 0.97),       # measured 0.992, 1.000
-    'close_in_view': (0.46, 0.21),  # measured 0.493, 0.244
+    'close_in_view': (0.48, 0.25),  # measured 0.517, 0.289
 }
 
 
@@ -245,3 +245,30 @@ def test_streaming_detector_on_the_scenarios(suite, name):
     floor_f, floor_recall = SCENARIO_FLOORS[name]
     assert counts.fmeasure > floor_f
     assert people.person_recall > floor_recall
+
+
+def test_a_person_in_view_from_the_start_is_not_taken_for_noise(suite):
+    # in_view's people stand in the first window's columns, and the masks call
+    # their pixels foreground there: the level of all the columns is their own
+    # change across the window. Read from consecutive columns (doubtful_floor
+    # 0.5) the levels let them through sooner. Measured on these frames, 0.5
+    # against 1 (the level of all the columns): F 0.524 / 0.499, person recall
+    # 0.308 / 0.233, precision 0.710 / 0.736 (docs/results.md).
+    from dgmod_ros import config
+    from dgmod_ros.sequence import stream_results
+    scenario = suite['in_view']
+    scores = {}
+    for floor in (config.DEFAULTS['doubtful_floor'], 1.0):
+        counts, people = ConfusionCounts(), PersonCounts()
+        values = dict(config.DEFAULTS, doubtful_floor=floor)
+        for frame, mask, _, _ in stream_results(scenario.frames(), values):
+            truth = scenario.render(frame.index)[1]
+            counts.add(mask, truth)
+            people.add(mask, truth)
+        scores[floor] = counts, people
+    assert config.DEFAULTS['doubtful_floor'] < 1.0
+    (counts, people), (whole, whole_people) = scores[config.DEFAULTS['doubtful_floor']], \
+        scores[1.0]
+    assert counts.fmeasure > whole.fmeasure + 0.012
+    assert people.person_recall > whole_people.person_recall + 0.04
+    assert counts.precision > whole.precision - 0.05

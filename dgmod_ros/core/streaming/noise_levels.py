@@ -17,6 +17,15 @@ columns: a young window of a few consecutive frames often has a walker in
 most of them. A pixel observed in fewer than half of the columns takes the
 median over all of them instead: the masks, not the pixel, are in doubt
 there (leaves that the first masks took for foreground keep their level).
+Where the columns hold a person in view while the window filled (a person
+beside the robot at its start), that median is the person's own change
+across the window, his pose and the folds of his clothes, and puts him
+under the threshold for as long as those columns stay. Such a pixel takes
+the level of the differences of consecutive columns instead (1.4826 times
+their median magnitude over sqrt(2)) where that is lower, but not below
+``doubtful_floor`` of the median over all columns: a person's clothes
+change slowly from frame to frame, leaves flicker from one to the next and
+keep their level.
 No pixel is taken as quieter than the frame's typical pixel (the median of
 ``sigma_p`` over the frame): only noisy places get a higher threshold, and a
 pixel seen fewer than :data:`MIN_OBSERVED` times gets the typical level. The
@@ -66,7 +75,8 @@ def observed_median(magnitude, observed=None):
     return ordered[np.arange(ordered.shape[0]), np.maximum(count - 1, 0) // 2], count
 
 
-def pixel_noise(residual, shape, observed=None, uniform=False, sample=None):
+def pixel_noise(residual, shape, observed=None, uniform=False, sample=None,
+                doubtful_floor=1.0):
     """
     Return each pixel's noise level ``sigma_p`` (n,) float32 from a window's residual.
 
@@ -85,18 +95,30 @@ def pixel_noise(residual, shape, observed=None, uniform=False, sample=None):
         The levels are read at ``sample``'s pixels, a coarser grid of the
         frame (:class:`~dgmod_ros.core.streaming.solve_resolution.PixelSample`),
         and upsampled to ``shape`` before the smoothing; None: at every pixel.
+    doubtful_floor : float in [0, 1]
+        A pixel observed in fewer than half of the columns takes the level of
+        the differences of consecutive columns where that is lower than the
+        level of all its columns, but not below this share of it; 1: the
+        level of all its columns (the module's docstring says why).
 
     """
-    return magnitude_noise(np.abs(residual).max(axis=0), shape, observed, uniform, sample)
+    differences = None
+    if doubtful_floor < 1.0 and observed is not None and residual.shape[2] >= 3:
+        differences = np.abs(np.diff(residual, axis=2)).max(axis=0)
+    return magnitude_noise(np.abs(residual).max(axis=0), shape, observed, uniform, sample,
+                           differences, doubtful_floor)
 
 
-def magnitude_noise(magnitude, shape, observed=None, uniform=False, sample=None):
+def magnitude_noise(magnitude, shape, observed=None, uniform=False, sample=None,
+                    differences=None, doubtful_floor=1.0):
     """
     Return :func:`pixel_noise` from the magnitude of the residual (n, m).
 
     ``magnitude`` is ``|D - L|``, largest over the channels, for a caller
     that has it already, or a non-negative statistic of its own (the
-    chromaticity distance); the other parameters are :func:`pixel_noise`'s.
+    chromaticity distance); ``differences`` (n, m - 1) the magnitude of the
+    differences of its consecutive columns, or None (no pixel's level read
+    from them); the other parameters are :func:`pixel_noise`'s.
     """
     rows, cols = shape[:2]
     median, count = observed_median(magnitude, observed)
@@ -105,6 +127,11 @@ def magnitude_noise(magnitude, shape, observed=None, uniform=False, sample=None)
         if doubtful.any():
             median[doubtful] = observed_median(magnitude[doubtful])[0]
             count[doubtful] = magnitude.shape[1]
+            if differences is not None:
+                # A difference holds the noise of two columns.
+                steps = row_median(differences[doubtful]) / math.sqrt(2.0)
+                median[doubtful] = np.maximum(np.minimum(median[doubtful], steps),
+                                              doubtful_floor * median[doubtful])
     sigma = _MAD_TO_SIGMA * median
     seen = count >= MIN_OBSERVED
     typical = float(np.median(sigma[seen])) if np.any(seen) else robust_sigma(magnitude)

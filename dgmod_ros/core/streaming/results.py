@@ -103,6 +103,7 @@ class WindowSnapshot:
     first_column: int = None    # admission count of the oldest column (warm-start shift)
     decision: str = 'global'    # likewise the decision rule ('adaptive' needs pixel noise)
     noise_source: str = 'solve'  # likewise the residual the pixel noise comes from
+    doubtful_floor: float = 1.0  # likewise how far consecutive differences lower a level
     solve_shape: tuple = None   # (rows, cols, C) the window is solved at; None: ``shape``
     refit_background: bool = False  # refit each pixel's series on the solve's factors
     warm_start: bool = True     # start from ``previous``'s iterates where they fit

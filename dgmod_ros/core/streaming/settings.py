@@ -34,6 +34,7 @@ WINDOW_CONSTRAINTS = {
     'absorb_frames': POSITIVE_INTEGER,
     'decision': [Options('adaptive', 'uniform', 'global')],
     'noise_source': [Options(*NOISE_SOURCES)],
+    'doubtful_floor': [Interval(Real, 0, 1, closed='both')],
     'pixel_k': POSITIVE,
     'median_size': [Interval(Integral, 1, None, odd=True)],
     'still_frames': NON_NEGATIVE_INTEGER,

@@ -159,6 +159,13 @@ class SlidingWindowDetector(StreamingDetector):
         projection on the fast path's basis (the distance the per-frame
         decision thresholds), or the larger of the 'solve' and 'projection'
         levels.
+    doubtful_floor : float, default=0.5
+        A pixel the window's masks called foreground in more than half of its
+        columns (a person in view while the window filled) reads its noise
+        level from the differences of consecutive columns where that is lower
+        than the level of all its columns, but not below this share of it
+        (:mod:`~dgmod_ros.core.streaming.noise_levels`; 'adaptive', 'uniform').
+        1 reads the level of all its columns.
     pixel_k : float, default=6.0
         Multiple of the noise level that makes a pixel foreground ('adaptive',
         'uniform').
@@ -285,12 +292,11 @@ class SlidingWindowDetector(StreamingDetector):
                  color='rgb', mask_rule=None, motion_threshold=0.0, min_frames=5, basis_rank=2,
                  global_change_fraction=0.7, memory_spacing=10, memory_columns=10,
                  conditional_update=True, hold_changes=False, absorb_frames=5400,
-                 decision='adaptive', noise_source='solve', pixel_k=6.0, median_size=5,
-                 ghost_test=True, still_frames=15, line_pixels=100, fill_holes=True,
-                 mrf_beta=2.0,
-                 chroma_cue=True, texture_cue=True, texture_bits=8, moving_texture_k=2.0,
-                 moving_texture_bits=16, solve_lag=5, solve_pixels=19200, solve_scale=0.5,
-                 warm_start=False, refit_background=True):
+                 decision='adaptive', noise_source='solve', doubtful_floor=0.5, pixel_k=6.0,
+                 median_size=5, ghost_test=True, still_frames=15, line_pixels=100,
+                 fill_holes=True, mrf_beta=2.0, chroma_cue=True, texture_cue=True,
+                 texture_bits=8, moving_texture_k=2.0, moving_texture_bits=16, solve_lag=5,
+                 solve_pixels=19200, solve_scale=0.5, warm_start=False, refit_background=True):
         self.model = model
         self.window = window
         self.stride = stride
@@ -309,6 +315,7 @@ class SlidingWindowDetector(StreamingDetector):
         self.absorb_frames = absorb_frames
         self.decision = decision
         self.noise_source = noise_source
+        self.doubtful_floor = doubtful_floor
         self.pixel_k = pixel_k
         self.median_size = median_size
         self.ghost_test = ghost_test
@@ -769,6 +776,7 @@ class SlidingWindowDetector(StreamingDetector):
                               observed=self.buffer_.observed(),
                               first_column=self.buffer_.first_column, decision=self.decision,
                               noise_source=self.noise_source,
+                              doubtful_floor=float(self.doubtful_floor),
                               solve_shape=solve_shape(self.shape_, int(self.solve_pixels),
                                                       float(self.solve_scale)),
                               refit_background=bool(self.refit_background),

@@ -99,7 +99,8 @@ def window_noise(snapshot, residuals, basis, observed, sample=None):
     source = snapshot.noise_source
 
     def level(residual):
-        return pixel_noise(residual, snapshot.shape, observed, uniform=uniform, sample=sample)
+        return pixel_noise(residual, snapshot.shape, observed, uniform=uniform, sample=sample,
+                           doubtful_floor=snapshot.doubtful_floor)
 
     if source == 'solve':
         return level(residuals)
