@@ -169,8 +169,9 @@ def test_what_a_moving_outline_encloses_is_published_whole(data_dir):
     # sbi_HumanBody2's first 120 frames: people in flat clothes whose colour
     # the window has seen where they walk are detected by their outlines, and
     # the fill publishes what the outlines enclose. Measured with the fill and
-    # without (fill_holes False): F 0.834 / 0.823, pixel recall 0.818 / 0.798,
-    # precision 0.851 / 0.849, false blobs 0.37 a frame both (docs/results.md).
+    # without (fill_holes False): F 0.848 / 0.836, pixel recall 0.853 / 0.832,
+    # precision 0.842 / 0.840, false blobs 0.37 a frame both (0.834 / 0.823,
+    # 0.818 / 0.798, 0.851 / 0.849 before doubtful_floor; docs/results.md).
     from dgmod_ros import config
     from dgmod_ros.core.metrics import ConfusionCounts, PersonCounts
     from dgmod_ros.evaluation import load_dataset
