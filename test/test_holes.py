@@ -6,6 +6,7 @@ from dgmod_ros.core.streaming import SlidingWindowDetector
 from dgmod_ros.core.streaming.holes import filled_holes
 import numpy as np
 import pytest
+from walls import wall_then
 
 
 def _ring(mask, top, bottom, left, right, width=1):
@@ -60,16 +61,15 @@ def test_an_empty_mask_and_a_full_mask_are_their_own_filling():
     assert filled_holes(full) is full
 
 
+def _paint_ring(image, wall):
+    """Draw a bright ring round the wall (8 x 14 processing pixels inside)."""
+    image[10:42, 40:82] = 0.95          # 16 x 21 processing pixels
+    image[16:36, 46:76] = wall[16:36, 46:76]
+
+
 def _wall_then_ring(frames=50, appear=40):
-    """Yield a textured wall; from ``appear`` on, a bright ring round the wall (8 x 14 inside)."""
-    rng = np.random.default_rng(5)
-    wall = rng.uniform(0.3, 0.6, (48, 96, 3)).astype(np.float32)
-    for index in range(frames):
-        image = wall + rng.normal(0, 0.004, wall.shape).astype(np.float32)
-        if index >= appear:
-            image[10:42, 40:82] = 0.95          # 16 x 21 processing pixels
-            image[16:36, 46:76] = wall[16:36, 46:76]
-        yield np.clip(image, 0, 1)
+    """Yield a textured wall; from ``appear`` on, a bright ring round the wall."""
+    return wall_then(_paint_ring, 5, frames, appear)
 
 
 @pytest.mark.parametrize('fill_holes', [True, False])

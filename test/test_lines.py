@@ -6,6 +6,7 @@ from dgmod_ros.core.streaming import SlidingWindowDetector
 from dgmod_ros.core.streaming.lines import processing_pixels_of, without_lines
 import numpy as np
 import pytest
+from walls import wall_then
 
 
 def _mask(*boxes):
@@ -61,16 +62,15 @@ def test_the_size_of_an_obstacle_is_counted_in_the_cameras_pixels():
     assert without_lines(_mask((5, 6, 10, 18)), vga).any()
 
 
+def _paint_line_and_box(image, wall):
+    """Draw a bright band two pixels high and a box."""
+    image[10:12, 10:80] = 0.95          # one processing row, 35 long
+    image[28:42, 60:76] = 0.95          # 7 x 8 processing pixels
+
+
 def _wall_then_line_and_box(frames=50, appear=40):
     """Yield a textured wall; from ``appear`` on, a bright band two pixels high and a box."""
-    rng = np.random.default_rng(3)
-    wall = rng.uniform(0.3, 0.6, (48, 96, 3)).astype(np.float32)
-    for index in range(frames):
-        image = wall + rng.normal(0, 0.004, wall.shape).astype(np.float32)
-        if index >= appear:
-            image[10:12, 10:80] = 0.95          # one processing row, 35 long
-            image[28:42, 60:76] = 0.95          # 7 x 8 processing pixels
-        yield np.clip(image, 0, 1)
+    return wall_then(_paint_line_and_box, 3, frames, appear)
 
 
 @pytest.mark.parametrize('line_pixels', [100, 0])
