@@ -102,23 +102,21 @@ def pixel_noise(residual, shape, observed=None, uniform=False, sample=None,
         level of all its columns (the module's docstring says why).
 
     """
-    differences = None
-    if doubtful_floor < 1.0 and observed is not None and residual.shape[2] >= 3:
-        differences = np.abs(np.diff(residual, axis=2)).max(axis=0)
     return magnitude_noise(np.abs(residual).max(axis=0), shape, observed, uniform, sample,
-                           differences, doubtful_floor)
+                           residual, doubtful_floor)
 
 
 def magnitude_noise(magnitude, shape, observed=None, uniform=False, sample=None,
-                    differences=None, doubtful_floor=1.0):
+                    residual=None, doubtful_floor=1.0):
     """
     Return :func:`pixel_noise` from the magnitude of the residual (n, m).
 
     ``magnitude`` is ``|D - L|``, largest over the channels, for a caller
     that has it already, or a non-negative statistic of its own (the
-    chromaticity distance); ``differences`` (n, m - 1) the magnitude of the
-    differences of its consecutive columns, or None (no pixel's level read
-    from them); the other parameters are :func:`pixel_noise`'s.
+    chromaticity distance); ``residual`` (C, n, m) the signed residual it
+    was taken from, whose consecutive differences a doubtful pixel's level
+    may come from, or None (none does); the other parameters are
+    :func:`pixel_noise`'s.
     """
     rows, cols = shape[:2]
     median, count = observed_median(magnitude, observed)
@@ -127,9 +125,10 @@ def magnitude_noise(magnitude, shape, observed=None, uniform=False, sample=None,
         if doubtful.any():
             median[doubtful] = observed_median(magnitude[doubtful])[0]
             count[doubtful] = magnitude.shape[1]
-            if differences is not None:
-                # A difference holds the noise of two columns.
-                steps = row_median(differences[doubtful]) / math.sqrt(2.0)
+            if residual is not None and doubtful_floor < 1.0 and residual.shape[2] >= 3:
+                # Only the doubtful rows: a difference holds the noise of two columns.
+                differences = np.abs(np.diff(residual[:, doubtful], axis=2)).max(axis=0)
+                steps = row_median(differences) / math.sqrt(2.0)
                 median[doubtful] = np.maximum(np.minimum(median[doubtful], steps),
                                               doubtful_floor * median[doubtful])
     sigma = _MAD_TO_SIGMA * median
