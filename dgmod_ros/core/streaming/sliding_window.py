@@ -41,6 +41,13 @@ _GHOST_LAG = 5
 _BORDER_KERNEL = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (5, 5))
 # Largest share of a blob's pixels that may change for the blob to count as still.
 _STILL_SHARE = 0.01
+# A pixel and its eight neighbours: the first frame is settled where all held still.
+_NEIGHBOURS = np.ones((3, 3), np.uint8)
+
+
+def _change(columns, earlier):
+    """Return each pixel's change (n,) against ``earlier``: the largest over the channels."""
+    return np.abs(columns - earlier).max(axis=0)
 
 
 class SlidingWindowDetector(StreamingDetector):
@@ -506,12 +513,12 @@ class SlidingWindowDetector(StreamingDetector):
         earlier = self.recent_[0][1] if len(self.recent_) == self.recent_.maxlen else None
         # Each pixel's change against the earlier frame, for the rules that ask it of pixels,
         # and the still test they share: within pixel_k / 2 noise levels of it.
-        change = None if earlier is None else np.abs(columns - earlier).max(axis=0)
+        change = None if earlier is None else _change(columns, earlier)
         still = (None if change is None or self.decision == 'global'
-                 else change <= self.pixel_k / 2 * np.asarray(level, dtype=np.float32))
+                 else self._holds(change, level))
         foreground, changed = self._decide(result, columns, background, level, earlier, change,
                                            still)
-        self._note_still(columns, still)
+        self._note_still(columns, still, level)
         result.buffered = self._admit(columns, background, foreground, result.frame_id,
                                       result.magnitude, level, still)
         self.previous_foreground_ = foreground.ravel() > 0
@@ -608,7 +615,7 @@ class SlidingWindowDetector(StreamingDetector):
         pixels |= uncovered
         values[:, uncovered] = columns[:, uncovered]
 
-    def _note_still(self, columns, still):
+    def _note_still(self, columns, still, level):
         """
         Keep each pixel's newest settled value and mark the pixels moving now.
 
@@ -623,17 +630,40 @@ class SlidingWindowDetector(StreamingDetector):
         evidence of the background, the way LaBGen picks, per pixel, the
         samples with the least motion. A pixel that never settled (leaves
         that never rest) is admitted as it is.
+
+        The first frame is where each pixel has settled if it and its eight
+        neighbours hold still into the second (within ``pixel_k / 2`` of
+        its ``level``): a person in view from the first frame moves into
+        places the first frame shows empty, and those places must not be
+        learnt from the frames he covers them in. A pixel that changed at
+        once (his moving limbs, leaves, a flickering codec) has not settled,
+        nor has one beside such a change (the plain inside of a body whose
+        outline moved, a leaf among leaves that did). Until the frame
+        ``_GHOST_LAG`` frames before exists, the still test is against the
+        first frame.
         """
-        if still is None:               # no earlier frame yet, or the global decision
+        if self.decision == 'global':   # no noise levels: the window takes the frames as they are
+            return
+        if self.still_value_ is None:   # the first frame (or the first after a reset)
+            self.still_value_ = columns.copy()
+            return
+        if self.still_known_ is None:   # the second: the first frame settled where it held
+            held = self._holds(_change(columns, self.still_value_), level)
+            held = held.reshape(self.shape_[:2])
+            self.still_known_ = cv2.erode(held.astype(np.uint8), _NEIGHBOURS).ravel() > 0
+        if still is None:               # before the lag's frame: against the first frame
+            still = self._holds(_change(columns, self.recent_[0][1]), level)
+            self.moving_ = ~still & self.still_known_
             return
         self.held_still_ = consecutive_frames(self.held_still_, still)
         settled = self.held_still_ >= _GHOST_LAG
-        if self.still_value_ is None:
-            self.still_value_ = columns.copy()
-            self.still_known_ = np.zeros_like(settled)
         np.copyto(self.still_value_, columns, where=settled[None, :])
         self.still_known_ |= settled
         self.moving_ = ~still & self.still_known_
+
+    def _holds(self, change, level):
+        """Return the pixels (n,) bool whose ``change`` is within ``pixel_k / 2`` noise levels."""
+        return change <= self.pixel_k / 2 * np.asarray(level, dtype=np.float32)
 
     def _admit(self, columns, background, foreground, frame_id, distance, level, still):
         """
@@ -680,6 +710,13 @@ class SlidingWindowDetector(StreamingDetector):
             columns, observed = conditional_columns(columns, background, grown,
                                                     self.foreground_age_, self.absorb_frames,
                                                     replace)
+        if self.moving_ is not None and self.moving_.any():
+            # A settled value put in place of the frame is no observation of
+            # the pixel's noise: counted, a pixel that never rests (a codec
+            # flickering from the first frame) would read its level from
+            # copies of one value, call its own flicker foreground and be
+            # replaced again.
+            observed = ~self.moving_ if observed is None else observed & ~self.moving_
         if self.heal_ is not None:
             # The place behind what left, seen since the last admission: every
             # column holds it from now on, so the next solve learns it.
