@@ -485,8 +485,23 @@ def main(args=None, kernel_compile=None):
             kernel_compile.stop()
         if node is not None:
             node.destroy_node()
-        rclpy.try_shutdown()
+        shut_down()
     return 0
+
+
+def shut_down():
+    """
+    Shut the default context down unless a signal already did.
+
+    ``rclpy.try_shutdown`` checks the context, then shuts it down; a SIGINT's
+    handler can shut it down in between (RCLError: rcl_shutdown already
+    called), which is the stop asked for, not a failure.
+    """
+    try:
+        rclpy.try_shutdown()
+    except Exception:  # noqa: B902 - rclpy's RCLError is private; re-raised unless shut down
+        if rclpy.ok():
+            raise
 
 
 if __name__ == '__main__':
