@@ -710,13 +710,6 @@ class SlidingWindowDetector(StreamingDetector):
             columns, observed = conditional_columns(columns, background, grown,
                                                     self.foreground_age_, self.absorb_frames,
                                                     replace)
-        if self.moving_ is not None and self.moving_.any():
-            # A settled value put in place of the frame is no observation of
-            # the pixel's noise: counted, a pixel that never rests (a codec
-            # flickering from the first frame) would read its level from
-            # copies of one value, call its own flicker foreground and be
-            # replaced again.
-            observed = ~self.moving_ if observed is None else observed & ~self.moving_
         if self.heal_ is not None:
             # The place behind what left, seen since the last admission: every
             # column holds it from now on, so the next solve learns it.
