@@ -23,7 +23,7 @@ from .kernels.texture import descriptor_distance, RELATIVE_THRESHOLD
 
 
 def moving_texture_k(columns, background, earlier, noise, k, weak_k, min_bits, shape,
-                     distance=None):
+                     distance=None, change=None):
     """
     Return each pixel's multiple of its noise level (n,) float32: ``weak_k`` where texture moved.
 
@@ -57,15 +57,19 @@ def moving_texture_k(columns, background, earlier, noise, k, weak_k, min_bits, s
         Processing shape.
     distance : ndarray (n,) or None
         ``|columns - background|``, largest over the channels, if already computed.
+    change : ndarray (n,) or None
+        ``|columns - earlier|``, largest over the channels, if already computed.
 
     """
     rows, cols, channels = shape
     if distance is None:
         distance = np.abs(columns - background).max(axis=0)
+    if change is None:
+        change = np.abs(columns - earlier).max(axis=0)
     level = np.broadcast_to(np.asarray(noise, dtype=np.float32), distance.shape)
     factor = np.full(distance.shape, k, dtype=np.float32)
     weak = (distance > weak_k * level) & (distance <= k * level)
-    weak &= np.abs(columns - earlier).max(axis=0) > weak_k * level
+    weak &= change > weak_k * level
     pixels = np.flatnonzero(weak)
     if pixels.size == 0:
         return factor
@@ -78,7 +82,8 @@ def moving_texture_k(columns, background, earlier, noise, k, weak_k, min_bits, s
 
 
 def adaptive_mask(columns, background, noise, k, shape, median_size, mrf_beta=0.0,
-                  lighting=None, chroma_level=None, earlier=None, weak_k=0.0, weak_bits=16):
+                  lighting=None, chroma_level=None, earlier=None, weak_k=0.0, weak_bits=16,
+                  change=None):
     """
     Return a frame's foreground at the processing size (uint8 0/255) and its distance.
 
@@ -111,6 +116,8 @@ def adaptive_mask(columns, background, noise, k, shape, median_size, mrf_beta=0.
         (:func:`moving_texture_k`); 0 disables.
     weak_bits : int
         Fewest differing LBSP bits of a changed texture (``weak_k`` > 0).
+    change : ndarray (n,) or None
+        ``|columns - earlier|``, largest over the channels, if already computed.
 
     """
     rows, cols = shape[:2]
@@ -118,7 +125,7 @@ def adaptive_mask(columns, background, noise, k, shape, median_size, mrf_beta=0.
     factor = k
     if weak_k > 0 and earlier is not None:
         factor = moving_texture_k(columns, background, earlier, noise, k, weak_k, weak_bits,
-                                  shape, distance)
+                                  shape, distance, change)
     changed = distance > factor * noise
     evidence = distance
     if lighting is not None:

@@ -45,9 +45,9 @@ _STILL_SHARE = 0.01
 _NEIGHBOURS = np.ones((3, 3), np.uint8)
 
 
-def _change(columns, earlier):
-    """Return each pixel's change (n,) against ``earlier``: the largest over the channels."""
-    return np.abs(columns - earlier).max(axis=0)
+def _change(columns, other):
+    """Return each pixel's distance (n,) to ``other``: the largest over the channels."""
+    return np.abs(columns - other).max(axis=0)
 
 
 class SlidingWindowDetector(StreamingDetector):
@@ -540,7 +540,7 @@ class SlidingWindowDetector(StreamingDetector):
         """
         rows, cols, _ = self.shape_
         if self.decision == 'global':
-            result.magnitude = np.abs(columns - background).max(axis=0).reshape(rows, cols)
+            result.magnitude = _change(columns, background).reshape(rows, cols)
             result.mask = self.mask_rule_.apply(result.magnitude, level, self.input_shape_)
             foreground = np.where(result.magnitude > level, np.uint8(255), np.uint8(0))
             return foreground, result.mask
@@ -548,7 +548,7 @@ class SlidingWindowDetector(StreamingDetector):
         foreground, result.magnitude = adaptive_mask(
             columns, background, level, self.pixel_k, self.shape_, self.median_size,
             self.mrf_beta, self.lighting_, model.chroma_noise if model is not None else None,
-            earlier, self.moving_texture_k, int(self.moving_texture_bits))
+            earlier, self.moving_texture_k, int(self.moving_texture_bits), change)
         # The scene-change rule counts every change, light included: after
         # the lights of most of the view switch, the lighting test would
         # hide the change while the window still holds the old light.
