@@ -277,18 +277,22 @@ def _walker_from_the_first_frame(frames, flicker, seed=5):
         yield image.astype(np.uint8), truth
 
 
+def _walker_masks(frames, flicker):
+    """Run the defaults on the walker; return the detector and ``(mask, truth)`` from frame 10."""
+    detector = SlidingWindowDetector()
+    masks = [(detector.process(image)[0].mask > 0, truth)
+             for image, truth in _walker_from_the_first_frame(frames, flicker)]
+    return detector, masks[10:]
+
+
 def test_a_walker_from_the_first_frame_is_not_learnt_where_the_first_frame_shows_the_wall():
     # Each place the walker moves into is covered for a window's fill; taken
     # as they are, those frames teach the window the walker. Where the first
     # frame held still into the second (with its eight neighbours) it shows
     # the wall: a pixel moving now enters with that value. Measured, frames
     # 10-39: recall 0.60 (0.25 with the frames' own values admitted).
-    detector = SlidingWindowDetector()
-    recall = []
-    for t, (image, truth) in enumerate(_walker_from_the_first_frame(40, flicker=False)):
-        mask = detector.process(image)[0].mask > 0
-        if t >= 10:
-            recall.append(np.count_nonzero(mask & truth) / np.count_nonzero(truth))
+    _, masks = _walker_masks(40, flicker=False)
+    recall = [np.count_nonzero(mask & truth) / np.count_nonzero(truth) for mask, truth in masks]
     assert np.mean(recall) > 0.5
 
 
@@ -298,13 +302,8 @@ def test_a_pixel_that_flickers_from_the_first_frame_is_admitted_as_it_is():
     # spread. Measured: none of the patch foreground over frames 10-89, the
     # window's columns spread by 0.031 there (0.5 % foreground and a spread
     # of 0.021 with the first frame taken as settled everywhere).
-    detector = SlidingWindowDetector()
-    foreground = []
-    for t, (image, _) in enumerate(_walker_from_the_first_frame(90, flicker=True)):
-        mask = detector.process(image)[0].mask > 0
-        if t >= 10:
-            foreground.append(np.count_nonzero(mask[4:24, 60:124]) / mask[4:24, 60:124].size)
-    assert np.mean(foreground) < 0.002
+    detector, masks = _walker_masks(90, flicker=True)
+    assert np.mean([mask[4:24, 60:124].mean() for mask, _ in masks]) < 0.002
     window = np.stack(detector.buffer_.columns())
     rows, cols, _ = detector.shape_
     patch = np.zeros((rows, cols), bool)
