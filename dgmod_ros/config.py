@@ -283,8 +283,10 @@ PARAMETERS = (
     Parameter('line_pixels', 100, 'a blob with no 3 x 3 square of foreground at the '
               'processing size is a line (the rim of a light that grew with the exposure, a '
               "cable's shadow), not a body: one that covers at least this many of the camera's "
-              'pixels leaves the published mask (the window still keeps it out); 0 = off', 0,
-              100000000, active_when=_PER_PIXEL),
+              'pixels leaves the published mask (the window still keeps it out); 0 = off. '
+              'Also the fewest pixels of a body that the filling window holds out where it came '
+              'in under a model (0: every blob)', 0, 100000000,
+              active_when=(_PER_PIXEL, {'conditional_update': True})),
     Parameter('fill_holes', True, "fill the published mask's holes: background that no path "
               "through the background joins to the frame's edge, enclosed by a body's outline "
               '(a flat coat whose colour the window has seen there); the window keeps the '

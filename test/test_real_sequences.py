@@ -48,15 +48,17 @@ def test_dgmod_beats_opencv_subtractors_on_ibmtest2(ibm):
 # keep the suite short (about 700 frames in all); the figures on the whole
 # clips are in docs/results.md. Each floor is about 0.03 below the F
 # measured on the same segment (docs/results.md, "Accuracy tests"; measured
-# again 2026-12-04 with the first frame settled, before it in brackets).
+# again 2026-12-05 with the fill holding out a body that came in under its
+# model, 2026-12-04 with the first frame settled in brackets).
 STREAM_SEGMENTS = {
-    'sbi_IBMtest2': (0, 90, 0.92),            # measured 0.953 (0.950)
-    'sbi_CAVIAR2': (0, 150, 0.88),            # measured 0.911 (0.910)
-    'sbi_CAVIAR1': (0, 150, 0.81),            # measured 0.855 (0.845)
-    'sbi_Candela_m1.10': (0, 200, 0.93),      # measured 0.962 (0.963; the person sits from ~40)
+    'sbi_IBMtest2': (0, 90, 0.92),            # measured 0.952 (0.953)
+    'sbi_CAVIAR2': (0, 150, 0.88),            # measured 0.912 (0.911)
+    'sbi_CAVIAR1': (0, 150, 0.83),            # measured 0.860 (0.855)
+    'sbi_Candela_m1.10': (0, 200, 0.93),      # measured 0.962 (0.962; the person sits from ~40)
     # Frames 470-649 scored. Started at frame 400, the trees are calm in its
     # first two frames and sway from about frame 450: specks of leaves.
-    'cdnet_highway': (400, 250, 0.92),        # measured 0.952 (0.961)
+    # Every blob held out while the window filled: 0.911 (leaves never learnt).
+    'cdnet_highway': (400, 250, 0.92),        # measured 0.951 (0.952)
 }
 
 

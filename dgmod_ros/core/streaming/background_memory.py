@@ -185,17 +185,19 @@ def conditional_columns(columns, background, foreground, foreground_age, absorb_
         Consecutive frames each pixel has been foreground.
     absorb_frames : int
         Foreground older than this is admitted as it is.
-    replace : bool
-        Put the background in place of the foreground; False (the window
-        still filling) admits the frame as it is, its foreground only not
-        observed.
+    replace : bool or ndarray (n,) bool
+        Where to put the background in place of the foreground: True
+        everywhere, False nowhere (the frame goes in as it is, its
+        foreground only not observed), or the pixels marked (the window
+        still filling: only where something came in under a model).
 
     """
     held = foreground & (foreground_age < absorb_frames)
     if not held.any():
         return columns, None
-    if replace:
-        columns = np.where(held[None, :], background, columns)
+    replaced = held & replace
+    if replaced.any():
+        columns = np.where(replaced[None, :], background, columns)
     return columns, ~held
 
 

@@ -74,3 +74,15 @@ class BlobMotion:
         if flags.any():
             mask[flags[self.labels]] = 0
             self.dropped |= flags
+
+
+def blobs_of_at_least(mask, min_pixels):
+    """
+    Return the 8-connected blobs of ``mask`` (rows, cols) uint8 with ``min_pixels`` pixels or more.
+
+    As uint8 0/1 (rows, cols); ``min_pixels`` 0 keeps every blob.
+    """
+    count, labels, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
+    large = stats[:, cv2.CC_STAT_AREA] >= min_pixels
+    large[0] = False
+    return large.astype(np.uint8)[labels]

@@ -13,7 +13,7 @@ import cv2
 import numpy as np
 
 from .background_memory import BackgroundMemory, conditional_columns, held_pixels
-from .blobs import BlobMotion
+from .blobs import BlobMotion, blobs_of_at_least
 from .buffer import SceneChangeWatch
 from .contract import StreamingDetector
 from .decision import adaptive_mask
@@ -139,9 +139,14 @@ class SlidingWindowDetector(StreamingDetector):
         processing size) replaced by the background, the frame's projection
         on the basis fit without that foreground (fit with it, it takes in
         part of the person), so that a person who stops is not learned into
-        the background. While the window fills,
-        frames go in as they are and their foreground is only left out of
-        the noise levels.
+        the background. While the window fills, only a body that came in
+        under a model is held out (foreground where the model called the
+        pixel background before in the fill, in blobs of at least
+        ``line_pixels`` camera pixels: a person who walks up in the first
+        second); the rest goes in as it is, its foreground only left out of
+        the noise levels (a person in view from the first frame, the ghost
+        of where he stood, leaves that were calm while the model was learnt;
+        see :meth:`_replaced`).
     hold_changes : bool, default=False
         The conditional update also keeps out the pixels over ``pixel_k / 2``
         noise levels from the background that are as far from the frame 5
@@ -207,7 +212,9 @@ class SlidingWindowDetector(StreamingDetector):
         the camera's pixels, an obstacle to a planner, is left out of the
         published mask but still kept out of the window
         (:mod:`~dgmod_ros.core.streaming.lines`; 'adaptive', 'uniform'). 0
-        keeps every blob.
+        keeps every blob. Also the fewest camera pixels of a body that the
+        filling window holds out where it came in under a model
+        (``conditional_update``; 0: every blob).
     fill_holes : bool, default=True
         Fill the holes of the published mask: background pixels that no path
         through the background joins to the frame's edge, enclosed by a
@@ -420,6 +427,7 @@ class SlidingWindowDetector(StreamingDetector):
         self.still_known_ = None         # (n,) bool: the pixel has settled once
         self.moving_ = None              # (n,) bool: moving now, settled before
         self.held_still_ = None
+        self.background_seen_ = None     # (n,) bool: background under a model in this fill
 
     def reset(self):
         """Forget every buffered frame and the background model."""
@@ -688,23 +696,20 @@ class SlidingWindowDetector(StreamingDetector):
             # takes the pixel's newest settled value there instead.
             columns = np.where(self.moving_[None, :], self.still_value_, columns)
         if self.conditional_update:
-            # While the window fills, every frame goes in as it is: the first
-            # solves must separate whatever moves in the first frames, and a
-            # model learnt from a few frames is no ground for holding pixels
-            # back. Its foreground is only left out of the noise levels.
-            replace = self.background_model_ is not None and not self.buffer_.filling
+            model = self.background_model_
             held = foreground
-            if replace and self.hold_changes and self.decision != 'global':
+            if (model is not None and not self.buffer_.filling and self.hold_changes
+                    and self.decision != 'global'):
                 held = self._held(foreground, still)
             # Dilated: a silhouette's border is foreground below the threshold.
             grown = cv2.dilate(held, _BORDER_KERNEL).ravel() > 0
-            if replace:
+            replace = self._replaced(foreground, grown)
+            if np.any(replace):
                 # In place of the foreground, the frame's projection on the
                 # basis fit without it: fit to the whole frame the projection
                 # takes in part of what stands there, and a person who stops
                 # would seep into the window admission by admission; fit to
                 # the rest it still follows the light.
-                model = self.background_model_
                 background = robust_projection(model.basis, frame, fit_basis=model.fit_basis,
                                                left_out=grown)
             columns, observed = conditional_columns(columns, background, grown,
@@ -719,6 +724,38 @@ class SlidingWindowDetector(StreamingDetector):
             self.heal_ = None
         self.buffer_.append(columns, frame_id, observed)
         return True
+
+    def _replaced(self, foreground, grown):
+        """
+        Return where the conditional update puts the background in place of ``grown``.
+
+        True (all of it) once the window is full, False (none) without a
+        model. While the window fills, the pixels (n,) bool of ``grown``
+        that a model called background in an earlier frame of the fill, in
+        blobs of ``foreground`` (rows, cols) large enough to be an obstacle
+        (``line_pixels`` of the camera's pixels, the 5 x 5 growth
+        included): a body came in there under the model, and a person who
+        walks up in the first second and stands would be learnt from the
+        fill's frames as they are. The rest of the fill's foreground goes in
+        as it is, only left out of the noise levels: a model learnt from a
+        few frames holds whoever was in view from the first frame and calls
+        the place behind him foreground where he stood (kept out, that ghost
+        would keep itself in the window), and leaves that were calm while
+        it was learnt flicker in specks (kept out, the window would never
+        learn their spread). Notes where this frame is background, for the
+        fill's frames after it.
+        """
+        if self.background_model_ is None:
+            return False
+        if not self.buffer_.filling:
+            return True
+        seen = self.background_seen_
+        self.background_seen_ = ~grown if seen is None else seen | ~grown
+        if seen is None:
+            return False
+        size = processing_pixels_of(self.line_pixels, foreground.shape, self.input_shape_)
+        bodies = cv2.dilate(blobs_of_at_least(foreground, size), _BORDER_KERNEL).ravel() > 0
+        return grown & seen & bodies
 
     def _held(self, foreground, still):
         """Return the frame's pixels (rows, cols) uint8 that the conditional update keeps out."""
