@@ -16,8 +16,18 @@ import signal
 import sys
 
 
-def _interrupt(signum, frame):
-    raise KeyboardInterrupt
+_STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+class _Stop:
+    """A stop signal's handler that also remembers it came: an import may swallow the interrupt."""
+
+    def __init__(self):
+        self.asked = False
+
+    def __call__(self, signum, frame):
+        self.asked = True
+        raise KeyboardInterrupt
 
 
 def main(args=None):
@@ -27,19 +37,30 @@ def main(args=None):
     from .core.kernel_cache import start_compile
 
     pending = None
-    # Until rclpy.init installs its handlers, SIGTERM stops the imports as
-    # Ctrl-C does, so the child is ended too.
-    previous = signal.signal(signal.SIGTERM, _interrupt)
+    # Until rclpy.init installs its handlers, SIGINT and SIGTERM stop the
+    # imports, so the child is ended too. Once in a clean-clone run a Ctrl-C
+    # at the first line was lost and the detector started: an import may
+    # swallow the KeyboardInterrupt (an optional module imported under a bare
+    # ``except``). The handler remembers the signal; the stop then comes
+    # after the import.
+    stop = _Stop()
+    previous = {number: signal.signal(number, stop) for number in _STOP_SIGNALS}
     try:
         pending = start_compile(get_logger('detector').info, say_ready=True)
         from .detector_node import main as run_node
     except KeyboardInterrupt:
-        if pending is not None:
-            pending.stop()
-        return 0
+        stop.asked = True
     finally:
-        signal.signal(signal.SIGTERM, previous)
-    return run_node(args, kernel_compile=pending)
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+    if not stop.asked:
+        try:
+            return run_node(args, kernel_compile=pending)
+        except KeyboardInterrupt:       # before rclpy.init installed its handlers
+            pass
+    if pending is not None:
+        pending.stop()
+    return 0
 
 
 if __name__ == '__main__':

@@ -148,6 +148,36 @@ def test_a_cold_start_says_it_compiles_and_stops_at_once(tmp_path, stop_signal, 
     assert _processes_with_home(tmp_path) == []      # the compiling child ended too
 
 
+@pytest.mark.parametrize('stop_signal', [signal.SIGINT, signal.SIGTERM])
+def test_a_stop_signal_that_an_import_swallows_still_stops_the_start(monkeypatch, stop_signal):
+    # A library that imports an optional module under a bare except swallows
+    # the KeyboardInterrupt of a Ctrl-C at the first line: once in a
+    # clean-clone run the detector then started and ran on. The entry's
+    # handler remembers the signal; the start stops after the import.
+    from dgmod_ros import detector_entry, detector_node
+    stopped, ran = [], []
+
+    class Compile:
+        def stop(self):
+            stopped.append(True)
+
+    def swallowing_start(log, say_ready):
+        try:
+            os.kill(os.getpid(), stop_signal)
+            for _ in range(1000):           # the handler runs between bytecodes
+                pass
+        except BaseException:  # noqa: B902 - what the library does
+            pass
+        return Compile()
+
+    monkeypatch.setattr(kernel_cache, 'start_compile', swallowing_start)
+    monkeypatch.setattr(detector_node, 'main', lambda *args, **kwargs: ran.append(True))
+    handlers = [signal.getsignal(number) for number in (signal.SIGINT, signal.SIGTERM)]
+    assert detector_entry.main() == 0
+    assert stopped == [True] and ran == []
+    assert [signal.getsignal(number) for number in (signal.SIGINT, signal.SIGTERM)] == handlers
+
+
 @pytest.mark.parametrize('shut_by_signal', [True, False])
 def test_the_last_shutdown_tolerates_a_signal_that_shut_the_context_first(monkeypatch,
                                                                           shut_by_signal):
