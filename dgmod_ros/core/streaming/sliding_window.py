@@ -506,7 +506,7 @@ class SlidingWindowDetector(StreamingDetector):
         bound = self.pixel_k * np.asarray(model.noise, dtype=np.float32)
 
         def changed_share(fitted):
-            return np.count_nonzero(np.abs(columns - fitted).max(axis=0) > bound) / bound.size
+            return np.count_nonzero(_change(columns, fitted) > bound) / bound.size
 
         if changed_share(background) <= self.global_change_fraction:
             return background
@@ -751,11 +751,12 @@ class SlidingWindowDetector(StreamingDetector):
             return True
         seen = self.background_seen_
         self.background_seen_ = ~grown if seen is None else seen | ~grown
-        if seen is None:
+        came_in = False if seen is None else grown & seen
+        if not np.any(came_in):         # nothing to label: the frame goes in as it is
             return False
         size = processing_pixels_of(self.line_pixels, foreground.shape, self.input_shape_)
         bodies = cv2.dilate(blobs_of_at_least(foreground, size), _BORDER_KERNEL).ravel() > 0
-        return grown & seen & bodies
+        return came_in & bodies
 
     def _held(self, foreground, still):
         """Return the frame's pixels (rows, cols) uint8 that the conditional update keeps out."""
