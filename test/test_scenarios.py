@@ -228,9 +228,12 @@ SCENARIO_FLOORS = {
                                     # before the fill held out a body that came in; 0.524,
                                     # 0.308 before the first frame counted as settled)
     'stops': (0.96, 0.97),          # measured 0.995, 1.000
-    'close_up': (0.92, 0.97),       # measured 0.959, 1.000 (0.495, 0.176 with every fit whole)
+    'close_up': (0.97, 0.97),       # measured 0.998, 1.000 (0.959, 1.000 before the fill
+                                    # closed a body cut by one side of the frame; 0.495,
+                                    # 0.176 with every fit whole)
     'crossing': (0.96, 0.97),       # measured 0.992, 1.000
-    'close_in_view': (0.55, 0.53),  # measured 0.581, 0.578 (0.554, 0.444; 0.517, 0.289)
+    'close_in_view': (0.57, 0.53),  # measured 0.601, 0.578 (0.581, 0.578 before the fill
+                                    # closed a body cut by one side; 0.554, 0.444; 0.517, 0.289)
 }
 
 

@@ -7,10 +7,17 @@ Where a person's clothes are one flat colour and the window has seen that
 colour at a pixel (a coat that covered it in earlier frames, a person in view
 from the first frame), the pixel's distance from its background is noise and
 the decision leaves it out, while the moving outline around it is far from
-the background and stays. What the outline encloses, background pixels no
-path along the frame's background reaches, belongs to the body: the mask a
-planner receives has the body whole. SuBSENSE (St-Charles et al., 2015) ends
-its decision with the same flood fill.
+the background and stays. What the outline encloses belongs to the body: the
+mask a planner receives has the body whole. SuBSENSE (St-Charles et al.,
+2015) ends its decision with the same flood fill.
+
+A person close to the camera is cut by the frame's edge, and his outline
+encloses his coat together with that edge. The scene's background reaches
+the frame's edge round a corner or on two of its sides; what reaches it on
+one side only, between two places where the outline meets that side, is
+enclosed by the outline and that side, and is filled too. An outline that
+meets two sides (a body in a corner) is left open: which of its sides is
+the body is not known.
 
 Only what is published is filled. The window keeps its own decision: a hole
 the fill closes wrongly (a ring of people, a doughnut of foreground around
@@ -35,21 +42,21 @@ def filled_holes(mask):
 
     Notes
     -----
-    A hole is a 4-connected set of background pixels that does not reach the
-    frame's edge: the 4-connected background is the complement of the
-    8-connected foreground the blob rules label, so a blob's outline that
-    touches only diagonally still closes it. A body cut by the frame's edge
-    is open there and is not closed along the edge: which side of an outline
-    that meets the edge twice is the body is not known.
+    A hole is a 4-connected set of background pixels that touches at most
+    one side of the frame, and no corner (a corner is on two sides): the
+    4-connected background is the complement of the 8-connected foreground
+    the blob rules label, so a blob's outline that touches only diagonally
+    still closes it.
 
     """
     if not mask.any():
         return mask
-    # The flood from a one-pixel frame of background reaches every pixel of
-    # the background that touches the edge, whatever touches it first.
-    reached = cv2.copyMakeBorder(mask, 1, 1, 1, 1, cv2.BORDER_CONSTANT, value=0)
-    cv2.floodFill(reached, None, (0, 0), 255, flags=4)
-    holes = reached[1:-1, 1:-1] == 0
+    count, labels = cv2.connectedComponents((mask == 0).astype(np.uint8), connectivity=4)
+    sides = np.zeros((4, count), bool)
+    for side, pixels in enumerate((labels[0], labels[-1], labels[:, 0], labels[:, -1])):
+        sides[side, pixels] = True
+    holes = sides.sum(axis=0) <= 1
+    holes[0] = False                    # label 0 is the foreground
     if not holes.any():
         return mask
-    return np.where(holes, np.uint8(255), mask)
+    return np.where(holes[labels], np.uint8(255), mask)

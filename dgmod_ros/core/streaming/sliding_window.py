@@ -216,9 +216,10 @@ class SlidingWindowDetector(StreamingDetector):
         filling window holds out where it came in under a model
         (``conditional_update``; 0: every blob).
     fill_holes : bool, default=True
-        Fill the holes of the published mask: background pixels that no path
-        through the background joins to the frame's edge, enclosed by a
-        body's outline (a flat coat whose colour the window has seen there;
+        Fill the holes of the published mask: background pixels enclosed by
+        a body's outline, or by it and one side of the frame (a flat coat
+        whose colour the window has seen there, a body cut by the frame's
+        edge; background that reaches two sides or a corner is the scene's:
         :mod:`~dgmod_ros.core.streaming.holes`; 'adaptive', 'uniform'). The
         window keeps the unfilled decision.
     mrf_beta : float, default=2.0
