@@ -38,26 +38,21 @@ def test_an_outline_joined_at_a_corner_only_still_encloses():
     assert not filled[0].any() and not filled[:, 0].any()
 
 
-def _u_open_at_the_bottom():
+def test_a_body_cut_by_one_side_of_the_frame_is_closed_along_it():
+    # A coat cut by the bottom edge (a U open there): its outline and that
+    # edge enclose it, while the scene round it reaches the edge on three sides.
     mask = np.zeros((30, 40), np.uint8)
     mask[10:30, 10:13] = 255
     mask[10:30, 27:30] = 255
     mask[10:13, 10:30] = 255
-    return mask
-
-
-def test_a_body_cut_by_one_side_of_the_frame_is_closed_along_it():
-    # A coat cut by the bottom edge: its outline and that edge enclose it,
-    # while the scene round it reaches the edge on three sides.
-    mask = _u_open_at_the_bottom()
     filled = filled_holes(mask)
     assert filled[10:30, 10:30].all()
     assert np.count_nonzero(filled) == 20 * 20
 
 
 def test_what_reaches_a_corner_or_two_sides_is_not_closed():
-    # The same outline in the bottom-left corner: what it holds reaches the
-    # left and the bottom side, and which side of it is the body is not known.
+    # An outline in the bottom-left corner: what it holds reaches the left
+    # and the bottom side, and which side of it is the body is not known.
     mask = np.zeros((30, 40), np.uint8)
     mask[10:13, 0:20] = 255
     mask[10:30, 17:20] = 255
