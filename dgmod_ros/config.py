@@ -287,10 +287,12 @@ PARAMETERS = (
               'Also the fewest pixels of a body that the filling window holds out where it came '
               'in under a model (0: every blob)', 0, 100000000,
               active_when=(_PER_PIXEL, {'conditional_update': True})),
-    Parameter('fill_holes', True, "fill the published mask's holes: background enclosed by a "
-              "body's outline, or by it and one side of the frame (a flat coat whose colour the "
-              'window has seen there, a body cut by the edge); background that reaches two '
-              "sides or a corner is the scene's; the window keeps the unfilled decision",
+    Parameter('fill_holes', True, "close the published mask with the field's 5 x 5 "
+              'neighbourhood (a gap it opened in an outline is bridged) and fill its holes: '
+              "background enclosed by a body's outline, or by it and one side of the frame (a "
+              'flat coat whose colour the window has seen there, a body cut by the edge); '
+              "background that reaches two sides or a corner is the scene's; the window keeps "
+              'the unfilled decision',
               active_when=_PER_PIXEL),
     Parameter('mrf_beta', 2.0, 'coupling of 5 x 5 neighbours in the Potts field that decides '
               'the per-pixel mask (log-odds per neighbour, mean field); 0 = threshold and '

@@ -1,9 +1,9 @@
 # Copyright 2026 dgmod_ros authors
 # Licensed under the Apache License, Version 2.0
-"""The published mask's holes are filled, with what a body cut by one side of the frame holds."""
+"""The published mask's outlines are bridged and its holes filled, a body cut by one side too."""
 
 from dgmod_ros.core.streaming import SlidingWindowDetector
-from dgmod_ros.core.streaming.holes import filled_holes
+from dgmod_ros.core.streaming.holes import closed_and_filled
 import numpy as np
 import pytest
 from walls import wall_then
@@ -18,7 +18,7 @@ def _ring(mask, top, bottom, left, right, width=1):
 def test_what_an_outline_encloses_is_filled():
     mask = _ring(np.zeros((30, 40), np.uint8), 5, 20, 10, 30)
     before = mask.copy()
-    filled = filled_holes(mask)
+    filled = closed_and_filled(mask)
     assert np.array_equal(mask, before)
     assert filled[5:20, 10:30].all()
     assert np.count_nonzero(filled) == 15 * 20
@@ -32,7 +32,7 @@ def test_an_outline_joined_at_a_corner_only_still_encloses():
         for row, col in ((10 - step, 4 + step), (10 - step, 16 - step),
                          (10 + step, 4 + step), (10 + step, 16 - step)):
             mask[row, col] = 255
-    filled = filled_holes(mask)
+    filled = closed_and_filled(mask)
     assert filled[10, 10] == 255
     assert filled[6:15, 10].all()
     assert not filled[0].any() and not filled[:, 0].any()
@@ -45,7 +45,7 @@ def test_a_body_cut_by_one_side_of_the_frame_is_closed_along_it():
     mask[10:30, 10:13] = 255
     mask[10:30, 27:30] = 255
     mask[10:13, 10:30] = 255
-    filled = filled_holes(mask)
+    filled = closed_and_filled(mask)
     assert filled[10:30, 10:30].all()
     assert np.count_nonzero(filled) == 20 * 20
 
@@ -56,28 +56,47 @@ def test_what_reaches_a_corner_or_two_sides_is_not_closed():
     mask = np.zeros((30, 40), np.uint8)
     mask[10:13, 0:20] = 255
     mask[10:30, 17:20] = 255
-    assert filled_holes(mask) is mask
+    filled = closed_and_filled(mask)
+    assert not filled[15:30, 0:15].any()
     # A post standing in it splits its touch of the bottom side, not its reach.
     mask = np.zeros((30, 40), np.uint8)
     mask[10:13, 0:30] = 255
     mask[10:30, 27:30] = 255
     mask[20:30, 5:8] = 255
-    filled = filled_holes(mask)
-    assert not filled[13:30, 8:27].any()
+    filled = closed_and_filled(mask)
+    assert not filled[14:30, 8:27].any()
 
 
 def test_background_between_two_people_is_not_filled():
     mask = np.zeros((30, 40), np.uint8)
     mask[5:25, 5:12] = 255
     mask[5:25, 20:27] = 255
-    assert filled_holes(mask) is mask
+    assert np.array_equal(closed_and_filled(mask), mask)
 
 
 def test_an_empty_mask_and_a_full_mask_are_their_own_filling():
     empty = np.zeros((10, 10), np.uint8)
     full = np.full((10, 10), 255, np.uint8)
-    assert filled_holes(empty) is empty
-    assert filled_holes(full) is full
+    assert closed_and_filled(empty) is empty
+    assert np.array_equal(closed_and_filled(full), full)
+
+
+@pytest.mark.parametrize('gap', [1, 2, 3, 4])
+def test_an_outline_opened_by_the_field_is_bridged(gap):
+    # The field's 5 x 5 neighbourhood can take a thin stretch of outline
+    # for noise: a gap narrower than it is bridged, and the coat inside filled.
+    mask = _ring(np.zeros((30, 40), np.uint8), 5, 25, 10, 30, width=3)
+    mask[5:8, 18:18 + gap] = 0
+    filled = closed_and_filled(mask)
+    assert filled[6:25, 10:30].all()          # a notch stays in the outer row
+
+
+def test_a_gap_wider_than_the_neighbourhood_is_the_scene():
+    mask = _ring(np.zeros((30, 40), np.uint8), 5, 25, 10, 30, width=3)
+    mask[5:8, 17:23] = 0
+    filled = closed_and_filled(mask)
+    assert not filled[10:20, 14:26].any()
+    assert not filled[5:8, 18:22].any()
 
 
 def _paint_ring(image, wall):

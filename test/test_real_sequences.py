@@ -48,17 +48,16 @@ def test_dgmod_beats_opencv_subtractors_on_ibmtest2(ibm):
 # keep the suite short (about 700 frames in all); the figures on the whole
 # clips are in docs/results.md. Each floor is about 0.03 below the F
 # measured on the same segment (docs/results.md, "Accuracy tests"; measured
-# again 2026-12-05 with the fill holding out a body that came in under its
-# model, 2026-12-04 with the first frame settled in brackets).
+# again 2026-12-05 with the fill bridging outlines).
 STREAM_SEGMENTS = {
-    'sbi_IBMtest2': (0, 90, 0.92),            # measured 0.952 (0.953)
-    'sbi_CAVIAR2': (0, 150, 0.88),            # measured 0.912 (0.911)
-    'sbi_CAVIAR1': (0, 150, 0.83),            # measured 0.860 (0.855)
-    'sbi_Candela_m1.10': (0, 200, 0.93),      # measured 0.962 (0.962; the person sits from ~40)
+    'sbi_IBMtest2': (0, 90, 0.92),            # measured 0.953
+    'sbi_CAVIAR2': (0, 150, 0.88),            # measured 0.906
+    'sbi_CAVIAR1': (0, 150, 0.83),            # measured 0.856
+    'sbi_Candela_m1.10': (0, 200, 0.93),      # measured 0.958 (the person sits from ~40)
     # Frames 470-649 scored. Started at frame 400, the trees are calm in its
     # first two frames and sway from about frame 450: specks of leaves.
     # Every blob held out while the window filled: 0.911 (leaves never learnt).
-    'cdnet_highway': (400, 250, 0.92),        # measured 0.951 (0.952)
+    'cdnet_highway': (400, 250, 0.92),        # measured 0.948
 }
 
 
@@ -173,12 +172,13 @@ def test_the_rims_of_ceiling_lights_are_no_obstacles(data_dir):
 def test_what_a_moving_outline_encloses_is_published_whole(data_dir):
     # sbi_HumanBody2's first 120 frames: people in flat clothes whose colour
     # the window has seen where they walk are detected by their outlines, and
-    # the fill publishes what the outlines enclose. Measured with the fill and
-    # without (fill_holes False): F 0.866 / 0.858, pixel recall 0.875 / 0.854,
-    # precision 0.857 / 0.862, false blobs 0.23 a frame both. The precision
-    # lost is the floor between a walker's legs where they are cut by the
-    # frame's bottom edge, closed with it (0.864 when only holes that reach no
-    # side were filled; docs/results.md).
+    # the fill publishes what the outlines enclose, gaps the field opened in
+    # them bridged. Measured with the fill and without (fill_holes False): F
+    # 0.879 / 0.858, pixel recall 0.908 / 0.854, precision 0.852 / 0.862,
+    # people found 137 / 132 of 151, false blobs 26 / 28 in 120 frames. The
+    # precision lost is the floor between a walker's legs where they are cut
+    # by the frame's bottom edge, closed with it, and the notches the closing
+    # fills (docs/results.md).
     from dgmod_ros import config
     from dgmod_ros.core.metrics import ConfusionCounts, PersonCounts
     from dgmod_ros.evaluation import load_dataset
@@ -194,7 +194,8 @@ def test_what_a_moving_outline_encloses_is_published_whole(data_dir):
             counts[fill].add(mask, truth, dataset.roi)
             people[fill].add(mask, truth)
     assert config.DEFAULTS['fill_holes']
-    assert counts[True].fmeasure > counts[False].fmeasure + 0.006
-    assert counts[True].recall > counts[False].recall + 0.012
-    assert counts[True].precision >= counts[False].precision - 0.01
-    assert people[True].false_blobs_per_frame == people[False].false_blobs_per_frame
+    assert counts[True].fmeasure > counts[False].fmeasure + 0.015
+    assert counts[True].recall > counts[False].recall + 0.04
+    assert counts[True].precision >= counts[False].precision - 0.015
+    assert people[True].found >= people[False].found
+    assert people[True].false_blobs <= people[False].false_blobs

@@ -18,8 +18,9 @@ and its ``_finish``), one module per stage:
    the background is wrong) and :mod:`.held_foreground` (blobs nothing moves in).
 6. :mod:`.lines`: blobs that are lines, not bodies, left out of the published
    mask (the window still keeps them out).
-7. :mod:`.holes`: what a body's outline encloses, alone or with one side of the
-   frame, filled in the published mask (the window keeps the unfilled decision).
+7. :mod:`.holes`: outlines bridged over the field's neighbourhood, and what a
+   body's outline encloses, alone or with one side of the frame, filled in the
+   published mask (the window keeps the unfilled decision).
 8. :mod:`.upsizing`: the mask at the camera's size.
 9. :mod:`.background_memory`: the frame admitted to the window every few frames,
    its foreground replaced by the background (conditional update).

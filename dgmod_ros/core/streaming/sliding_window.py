@@ -20,7 +20,7 @@ from .decision import adaptive_mask
 from .fast_path import robust_projection
 from .ghost import ghost_labels, ghost_parts
 from .held_foreground import consecutive_frames, moved_inside, still_blob_pixels
-from .holes import filled_holes
+from .holes import closed_and_filled
 from .kernels.warmup_background import entry_medians
 from .lines import processing_pixels_of, without_lines
 from .noise_levels import warmup_noise
@@ -216,10 +216,12 @@ class SlidingWindowDetector(StreamingDetector):
         filling window holds out where it came in under a model
         (``conditional_update``; 0: every blob).
     fill_holes : bool, default=True
-        Fill the holes of the published mask: background pixels enclosed by
-        a body's outline, or by it and one side of the frame (a flat coat
-        whose colour the window has seen there, a body cut by the frame's
-        edge; background that reaches two sides or a corner is the scene's:
+        Close the published mask with the Potts field's neighbourhood (a
+        gap the field opened in an outline is bridged) and fill its holes:
+        background pixels enclosed by a body's outline, or by it and one
+        side of the frame (a flat coat whose colour the window has seen
+        there, a body cut by the frame's edge; background that reaches two
+        sides or a corner is the scene's:
         :mod:`~dgmod_ros.core.streaming.holes`; 'adaptive', 'uniform'). The
         window keeps the unfilled decision.
     mrf_beta : float, default=2.0
@@ -570,7 +572,7 @@ class SlidingWindowDetector(StreamingDetector):
         line_size = processing_pixels_of(self.line_pixels, foreground.shape, self.input_shape_)
         published = without_lines(foreground, line_size)
         if self.fill_holes:
-            published = filled_holes(published)
+            published = closed_and_filled(published)
         result.mask = to_input_size(published, self.input_shape_)
         return foreground, changed
 
