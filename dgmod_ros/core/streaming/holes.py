@@ -30,10 +30,10 @@ alone stays a speck.
 
 Only what is published is closed and filled. The window keeps its own
 decision: a hole the fill closes wrongly (a ring of people, a doughnut of
-foreground around real background) must not keep that background out of the next solves.
-Measured the other way (the holes kept out of the window too), mean F was
-the same within 0.002 and person recall moved both ways from clip to clip
-(``docs/results.md``).
+foreground around real background) must not keep that background out of the
+next solves. Measured the other way (the holes kept out of the window too),
+mean F was the same within 0.002 and person recall moved both ways from clip
+to clip (``docs/results.md``).
 """
 
 import cv2
