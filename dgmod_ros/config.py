@@ -275,10 +275,11 @@ PARAMETERS = (
               'is an edge of the background rather than of the frame (ghosts of what has '
               'left); they heal the window',
               active_when=_PER_PIXEL),
-    Parameter('still_frames', 15, 'drop pixels that have been in a still blob (nothing in it '
-              'changed by pixel_k / 2 noise levels over 5 frames) for this many frames, unless '
-              'the blob was seen to come in (most of its pixels moved while foreground): '
-              'ghosts that uncover texture; they heal the window; 0 = off', 0, 1000000,
+    Parameter('still_frames', 15, 'drop pixels that have been in a still blob (at most 1 % '
+              'of it, or one pixel, changed by pixel_k / 2 noise levels over 5 frames) for '
+              'this many frames, unless the blob was seen to come in (most of its pixels '
+              'moved while foreground): ghosts that uncover texture; they heal the window; '
+              '0 = off', 0, 1000000,
               active_when=_PER_PIXEL),
     Parameter('line_pixels', 100, 'a blob with no 3 x 3 square of foreground at the '
               'processing size is a line (the rim of a light that grew with the exposure, a '

@@ -57,8 +57,20 @@ def test_still_blob_pixels_allows_the_given_share_of_changed_pixels():
     mask = _two_blobs()
     earlier = np.zeros((3, mask.size), np.float32)
     frame = earlier.copy()
-    frame[:, np.ravel_multi_index(([12], [18]), mask.shape)] = 0.5   # 1 of 80 pixels
-    assert still_blob_pixels(mask, frame, earlier, 0.01, 3.0, 0.02)[10:18, 15:25].all()
+    frame[:, np.ravel_multi_index(([12, 13], [18, 18]), mask.shape)] = 0.5   # 2 of 80 pixels
+    assert still_blob_pixels(mask, frame, earlier, 0.01, 3.0, 0.03)[10:18, 15:25].all()
+    assert not still_blob_pixels(mask, frame, earlier, 0.01, 3.0, 0.02)[10:18, 15:25].any()
+
+
+def test_still_blob_pixels_allows_one_changed_pixel_in_a_blob_below_one_over_the_share():
+    # 80 pixels at a share of 0.01 would allow 0.8: one pixel of noise past the
+    # level would keep a small ghost from ever being still.
+    mask = _two_blobs()
+    earlier = np.zeros((3, mask.size), np.float32)
+    frame = earlier.copy()
+    frame[:, np.ravel_multi_index(([12], [18]), mask.shape)] = 0.5
+    assert still_blob_pixels(mask, frame, earlier, 0.01, 3.0, 0.01)[10:18, 15:25].all()
+    frame[:, np.ravel_multi_index(([13], [18]), mask.shape)] = 0.5
     assert not still_blob_pixels(mask, frame, earlier, 0.01, 3.0, 0.01)[10:18, 15:25].any()
 
 

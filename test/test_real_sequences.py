@@ -199,3 +199,24 @@ def test_what_a_moving_outline_encloses_is_published_whole(data_dir):
     assert counts[True].precision >= counts[False].precision - 0.015
     assert people[True].found >= people[False].found
     assert people[True].false_blobs <= people[False].false_blobs
+
+
+def test_a_small_ghost_with_one_noisy_pixel_still_heals(data_dir):
+    # sbi_HumanBody2 started at frame 120 (40 %), a man standing at the table
+    # in its first frame: the place his legs uncover by the table's leg is a
+    # ghost of about 40 processing pixels, where one pixel past the still
+    # test's level every few frames restarted its count (a share of 0.01 of 40
+    # pixels allows none). Measured with one pixel allowed / without: false
+    # blobs 0.26 / 0.50 a frame, person recall 0.851 both (docs/results.md).
+    from dgmod_ros import config
+    from dgmod_ros.core.metrics import PersonCounts
+    from dgmod_ros.evaluation import load_dataset
+    from dgmod_ros.inputs import read_frames
+    from dgmod_ros.sequence import stream_results
+    dataset = load_dataset(data_dir / 'sbi_HumanBody2')
+    frames = list(read_frames(dataset.path))[120:300]
+    people = PersonCounts()
+    for frame, mask, _, _ in stream_results(frames, dict(config.DEFAULTS)):
+        people.add(mask, cv2.imread(str(dataset.truths[frame.index]), cv2.IMREAD_GRAYSCALE))
+    assert people.false_blobs_per_frame < 0.35
+    assert people.person_recall > 0.82

@@ -17,10 +17,10 @@ in the frame and passes for an object.
 What a ghost has and a stopped person has not is stillness: the uncovered
 background holds only sensor noise, while a seated person breathes, turns a
 head, shifts a hand. A blob is *still* when at most ``share`` of its pixels
-changed by more than ``k`` noise levels against the frame a few frames
-before. A pixel that has been in a still blob for ``still_frames``
-consecutive frames is dropped from the mask and enters the window as it is,
-which heals the background.
+(or one pixel, whatever its size) changed by more than ``k`` noise levels
+against the frame a few frames before. A pixel that has been in a still
+blob for ``still_frames`` consecutive frames is dropped from the mask and
+enters the window as it is, which heals the background.
 
 Stillness alone does not tell a ghost from a person who stops dead (a
 person standing still beside the robot, a bag put down): what the scene
@@ -84,7 +84,8 @@ def still_blob_pixels(mask, frame, earlier, noise, k, share, blobs=None, entered
     k : float
         Multiple of the noise level that counts as a change.
     share : float
-        Largest share of a blob's pixels that may change for the blob to be still.
+        Largest share of a blob's pixels that may change for the blob to be
+        still; one pixel may change in a blob of any size.
     blobs : BlobMotion or None
         The blobs of ``mask`` (or of a mask from which :meth:`BlobMotion.drop`
         removed blobs) against ``earlier``, when already labelled.
@@ -95,7 +96,12 @@ def still_blob_pixels(mask, frame, earlier, noise, k, share, blobs=None, entered
     """
     if blobs is None:
         blobs = BlobMotion(mask, frame, earlier, noise)
-    still = blobs.moving_share(k) <= share
+    # One pixel past k levels is allowed whatever the blob's size: below 1 / share
+    # pixels the share would ask every pixel to hold, and one pixel of sensor
+    # noise every few frames would keep restarting a small ghost's count.
+    sizes = np.bincount(blobs.labels.ravel(), minlength=blobs.count)
+    moved = np.rint(blobs.moving_share(k) * sizes)
+    still = moved <= np.maximum(share * sizes, 1)
     still[0] = False
     still &= ~blobs.dropped
     if entered is not None and still.any():
