@@ -52,6 +52,14 @@ class BlobMotion:
         self.dropped = np.zeros(self.count, dtype=bool)
         self._frame, self._earlier, self._noise = frame, earlier, noise
         self._shares = {}
+        self._sizes = None
+
+    @property
+    def sizes(self):
+        """Per label (count,) int64 its pixels, label 0 (the background) included."""
+        if self._sizes is None:
+            self._sizes = np.bincount(self.labels.ravel(), minlength=self.count)
+        return self._sizes
 
     def moving_share(self, k):
         """Return per label (count,) float64 the share of pixels changed by over ``k`` levels."""

@@ -65,8 +65,7 @@ def came_in(blobs, entered):
     """
     labels = blobs.labels.ravel()
     inside = np.bincount(labels[entered.ravel()], minlength=blobs.count)
-    total = np.bincount(labels, minlength=blobs.count)
-    return 2 * inside > total
+    return 2 * inside > blobs.sizes
 
 
 def still_blob_pixels(mask, frame, earlier, noise, k, share, blobs=None, entered=None):
@@ -99,9 +98,8 @@ def still_blob_pixels(mask, frame, earlier, noise, k, share, blobs=None, entered
     # One pixel past k levels is allowed whatever the blob's size: below 1 / share
     # pixels the share would ask every pixel to hold, and one pixel of sensor
     # noise every few frames would keep restarting a small ghost's count.
-    sizes = np.bincount(blobs.labels.ravel(), minlength=blobs.count)
-    moved = np.rint(blobs.moving_share(k) * sizes)
-    still = moved <= np.maximum(share * sizes, 1)
+    one_pixel = 1.0 / np.maximum(blobs.sizes, 1)
+    still = blobs.moving_share(k) <= np.maximum(share, one_pixel)
     still[0] = False
     still &= ~blobs.dropped
     if entered is not None and still.any():
