@@ -20,9 +20,9 @@ The output is never part of the repository (the frames are the shared data's).
 
 import argparse
 from pathlib import Path
-import shutil
 
 import cv2
+from dgmod_ros.evaluation import write_composite
 import numpy as np
 
 FPS = 30.0
@@ -59,18 +59,14 @@ def main(argv=None):
     parser.add_argument('--amplitude', type=float, default=3.0, help='pixels')
     parser.add_argument('--share', type=float, default=1 / 3, help='of the width, from the left')
     args = parser.parse_args(argv)
-    (args.out / 'input').mkdir(parents=True, exist_ok=True)
-    shutil.copytree(args.source / 'groundtruth', args.out / 'groundtruth', dirs_exist_ok=True)
-    for name in ('temporalROI.txt', 'ROI.bmp'):
-        if (args.source / name).exists():
-            shutil.copy(args.source / name, args.out / name)
-    field = region = None
-    for index, path in enumerate(sorted((args.source / 'input').iterdir())):
-        image = cv2.imread(str(path))
-        if field is None:
-            field, region = sway_field(image.shape[:2], args.share)
-        cv2.imwrite(str(args.out / 'input' / path.name),
-                    swayed(image, field, region, index, args.period, args.amplitude))
+    fields = []
+
+    def transform(index, image):
+        if not fields:
+            fields.extend(sway_field(image.shape[:2], args.share))
+        return swayed(image, *fields, index, args.period, args.amplitude)
+
+    write_composite(args.source, args.out, transform)
     return 0
 
 

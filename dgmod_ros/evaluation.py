@@ -14,6 +14,7 @@ background falls back to its median over all scored frames.
 from dataclasses import dataclass
 import json
 from pathlib import Path
+import shutil
 import time
 
 import cv2
@@ -53,6 +54,30 @@ def load_dataset(path):
     roi = cv2.imread(str(path / 'ROI.bmp'), cv2.IMREAD_GRAYSCALE) \
         if (path / 'ROI.bmp').is_file() else None
     return Dataset(path.name, path, truths, max(first, 1) - 1, min(last, count) - 1, roi)
+
+
+def write_composite(source, out, transform, suffix=None):
+    """
+    Write a copy of the CDnet-style folder ``source`` whose inputs pass ``transform``.
+
+    ``transform(index, image)`` takes each input frame in order (BGR uint8, as
+    OpenCV reads it) and returns the frame to write; the ground truth,
+    ``temporalROI.txt`` and ``ROI.bmp`` are copied as they are. ``suffix``
+    (``'.png'``) names the written frames; None keeps each input's name.
+    Return the number of frames written (the benchmarks' composites).
+    """
+    source, out = Path(source), Path(out)
+    (out / 'input').mkdir(parents=True, exist_ok=True)
+    shutil.copytree(source / 'groundtruth', out / 'groundtruth', dirs_exist_ok=True)
+    for name in ('temporalROI.txt', 'ROI.bmp'):
+        if (source / name).exists():
+            shutil.copy(source / name, out / name)
+    paths = sorted((source / 'input').iterdir())
+    for index, path in enumerate(paths):
+        name = path.name if suffix is None else path.stem + suffix
+        cv2.imwrite(str(out / 'input' / name),
+                    transform(index, cv2.imread(str(path), cv2.IMREAD_COLOR)))
+    return len(paths)
 
 
 def _grey(frame):

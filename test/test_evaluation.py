@@ -8,7 +8,7 @@ import cv2
 from dgmod_ros import config
 from dgmod_ros.core.preprocess import to_float_channels
 from dgmod_ros.core.synthetic import synthetic_scene
-from dgmod_ros.evaluation import evaluate, load_dataset, reference_background
+from dgmod_ros.evaluation import evaluate, load_dataset, reference_background, write_composite
 from dgmod_ros.inputs import read_frames
 import numpy as np
 import pytest
@@ -53,3 +53,22 @@ def test_evaluate_scores_every_method_and_writes_its_outputs(dataset, tmp_path):
     for name in ('results.md', 'figure1_backgrounds_synthetic.png',
                  'figure2_foregrounds_synthetic.png'):
         assert (tmp_path / name).is_file()
+
+
+def test_a_composite_copies_the_truth_and_passes_each_frame_through_in_order(dataset, tmp_path):
+    _, root = dataset
+    seen = []
+
+    def transform(index, image):
+        seen.append(index)
+        return 255 - image
+
+    out = tmp_path / 'composite'
+    assert write_composite(root, out, transform, suffix='.png') == 30
+    assert seen == list(range(30))
+    assert (out / 'temporalROI.txt').read_text() == (root / 'temporalROI.txt').read_text()
+    assert sorted(p.name for p in (out / 'groundtruth').iterdir()) == \
+        sorted(p.name for p in (root / 'groundtruth').iterdir())
+    first = cv2.imread(str(root / 'input' / 'in000001.png'))
+    assert np.array_equal(cv2.imread(str(out / 'input' / 'in000001.png')), 255 - first)
+    assert (load_dataset(out).first, load_dataset(out).last) == (10, 29)

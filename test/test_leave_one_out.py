@@ -2,21 +2,13 @@
 # Licensed under the Apache License, Version 2.0
 """The leave-one-out benchmark's choice, summary and cache, on made-up scores (no data)."""
 
-import importlib.util
-from pathlib import Path
-
+from benchmark_modules import load
 import pytest
-
-REPO = Path(__file__).resolve().parents[1]
 
 
 @pytest.fixture(scope='module')
 def loo():
-    spec = importlib.util.spec_from_file_location(
-        'leave_one_out', REPO / 'benchmarks' / 'leave_one_out.py')
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load('leave_one_out')
 
 
 SEQUENCES = ['a', 'b', 'c', 'd']
