@@ -70,11 +70,12 @@ def main(argv=None):
     parser.add_argument('--quality', type=int, default=90,
                         help='JPEG quality of a re-encoded block')
     args = parser.parse_args(argv)
-    written = [None]
+    written = None
 
     def transform(index, image):
-        written[0] = replenished(written[0], image, args.threshold, args.quality)
-        return written[0]
+        nonlocal written
+        written = replenished(written, image, args.threshold, args.quality)
+        return written
 
     write_composite(args.source, args.out, transform, suffix='.png')
     return 0

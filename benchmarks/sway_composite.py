@@ -59,12 +59,13 @@ def main(argv=None):
     parser.add_argument('--amplitude', type=float, default=3.0, help='pixels')
     parser.add_argument('--share', type=float, default=1 / 3, help='of the width, from the left')
     args = parser.parse_args(argv)
-    fields = []
+    field = region = None
 
     def transform(index, image):
-        if not fields:
-            fields.extend(sway_field(image.shape[:2], args.share))
-        return swayed(image, *fields, index, args.period, args.amplitude)
+        nonlocal field, region
+        if field is None:
+            field, region = sway_field(image.shape[:2], args.share)
+        return swayed(image, field, region, index, args.period, args.amplitude)
 
     write_composite(args.source, args.out, transform)
     return 0
