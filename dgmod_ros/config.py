@@ -298,8 +298,9 @@ PARAMETERS = (
     Parameter('mrf_beta', 2.0, 'coupling of 5 x 5 neighbours in the Potts field that decides '
               'the per-pixel mask (log-odds per neighbour, mean field); 0 = threshold and '
               'median filter (median_size)', 0.0, 100.0, active_when=_PER_PIXEL),
-    Parameter('pixel_k', 6.0, 'multiple of the noise level that makes a pixel foreground',
-              0.1, 100.0, active_when=_PER_PIXEL),
+    Parameter('pixel_k', 6.0, 'multiple of the noise level that makes a pixel foreground '
+              "(and of the level of a pixel's steps between window columns past which its "
+              'level is an offset of the model, not noise)', 0.1, 100.0, active_when=_PER_PIXEL),
     Parameter('median_size', 5, 'median filter of the thresholded per-pixel decision at the '
               'processing size (odd; 1 = off)', 1, 15, 2,
               active_when={**_PER_PIXEL, 'mrf_beta': 0.0}),

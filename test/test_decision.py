@@ -781,3 +781,48 @@ def test_a_doubtful_pixel_that_changes_slowly_takes_the_level_of_its_differences
     # Without masks no pixel is doubtful: the floor changes nothing.
     assert np.array_equal(pixel_noise(residual, shape, doubtful_floor=0.0),
                           pixel_noise(residual, shape))
+
+
+def test_a_pixel_the_model_misses_by_the_same_amount_takes_the_level_of_its_differences():
+    # 12 columns, all observed (the masks called the pixels background). Top-left
+    # block: the model is off by 0.2 in every column (a person learnt in another
+    # pose), with noise 0.01. Bottom-right block: leaves off by 0.2 in every
+    # other column. Elsewhere noise 0.01 only.
+    rows, cols, columns = 20, 20, 12
+    residual = _quiet_residual(rows, cols, columns)
+    offset = np.zeros((rows, cols), bool)
+    offset[:6, :6] = True
+    leaves = np.zeros((rows, cols), bool)
+    leaves[14:, 14:] = True
+    residual[0, offset.ravel()] += 0.2
+    residual[0, leaves.ravel()] += 0.2 * (np.arange(columns) % 2).astype(np.float32)
+    shape = (rows, cols, 1)
+    plain, split = (pixel_noise(residual, shape, offset_k=k).reshape(rows, cols)
+                    for k in (0.0, 6.0))
+    assert plain[2, 2] > 0.25                              # 1.4826 * 0.2
+    # Consecutive columns differ by the noise alone: the level of 0.01 noise.
+    assert split[2, 2] == pytest.approx(0.01, rel=0.3)
+    assert 6.0 * split[2, 2] < 0.2                        # the offset is foreground again
+    # The leaves' differences are as large as their residual: they keep their level.
+    assert np.array_equal(plain[16:, 16:], split[16:, 16:])
+    assert split[17, 17] > 0.1
+    # Quiet pixels are no offset of six times their differences: they keep their level.
+    assert np.array_equal(plain[:8, 9:], split[:8, 9:])
+
+
+def test_an_offset_level_stays_at_or_above_the_frames_typical_level():
+    # A recording that copies unchanged blocks: every pixel repeats exactly from
+    # column to column (steps of 0) and the model misses each by a small amount,
+    # most by 0.01; a block by 0.1. The typical level is read before the offset
+    # rule: no pixel goes below the model's usual miss.
+    rows, cols, columns = 20, 20, 12
+    miss = np.full((rows, cols), 0.01, np.float32)
+    miss[:6, :6] = 0.1
+    residual = np.repeat(miss.reshape(1, -1, 1), columns, axis=2)
+    shape = (rows, cols, 1)
+    plain, split = (pixel_noise(residual, shape, offset_k=k).reshape(rows, cols)
+                    for k in (0.0, 6.0))
+    typical = 1.4826 * 0.01
+    assert np.allclose(plain[10:, 10:], typical) and np.allclose(split[10:, 10:], typical)
+    assert plain[2, 2] == pytest.approx(1.4826 * 0.1)
+    assert split[2, 2] == pytest.approx(typical)

@@ -224,7 +224,9 @@ def test_command_line_writes_the_suite(material, data_dir, tmp_path, monkeypatch
 # (at this scale close_in_view is 45 frames, most of them while the window
 # still fills with consecutive frames: the figures are those of a first start).
 SCENARIO_FLOORS = {
-    'in_view': (0.59, 0.52),        # measured F 0.616, person recall 0.558 (0.593, 0.492
+    'in_view': (0.59, 0.52),        # measured F 0.621, person recall 0.558 (0.616, 0.558
+                                    # before a level the model misses by in every column
+                                    # was read as its offset; 0.593, 0.492
                                     # before the fill bridged outlines; 0.565, 0.383 before
                                     # it held out a body that came in; 0.524, 0.308 before
                                     # the first frame counted as settled)
@@ -233,7 +235,8 @@ SCENARIO_FLOORS = {
                                     # closed a body cut by one side of the frame; 0.495,
                                     # 0.176 with every fit whole)
     'crossing': (0.96, 0.97),       # measured 0.989, 1.000
-    'close_in_view': (0.62, 0.59),  # measured 0.654, 0.622 (0.601, 0.578 before the fill
+    'close_in_view': (0.63, 0.57),  # measured 0.661, 0.600 (0.654, 0.622 before the offset
+                                    # level; 0.601, 0.578 before the fill
                                     # bridged outlines; 0.581, 0.578 before it closed a body
                                     # cut by one side; 0.554, 0.444; 0.517, 0.289)
 }

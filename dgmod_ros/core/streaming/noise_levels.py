@@ -26,9 +26,22 @@ their median magnitude over sqrt(2)) where that is lower, but not below
 ``doubtful_floor`` of the median over all columns: a person's clothes
 change slowly from frame to frame, leaves flicker from one to the next and
 keep their level.
+A level is the scale of what the model does not explain from one column to
+the next. Where a pixel's median exceeds ``offset_k`` times the level of the
+differences of its consecutive columns, the model misses it by an amount
+that holds or drifts slowly: an offset the window's background carries (a
+person in view while the window filled, learnt in another pose; the blur of
+a person who has moved on), which a level of its size would hide from the
+decision. Such a pixel takes the level of its differences. Leaves and a
+flickering screen change from one column to the next and keep their level;
+a background that sways slowly (a period of seconds) reads as an offset
+too, which is this rule's price (docs/results.md).
 No pixel is taken as quieter than the frame's typical pixel (the median of
-``sigma_p`` over the frame): only noisy places get a higher threshold, and a
-pixel seen fewer than :data:`MIN_OBSERVED` times gets the typical level. The
+``sigma_p`` over the frame, read before the offset rule: a recording that
+copies most blocks exactly has steps of 0 nearly everywhere, and its
+typical pixel is still the model's usual miss): only noisy places get a
+higher threshold, and a pixel seen fewer than :data:`MIN_OBSERVED` times
+gets the typical level. The
 levels are smoothed by the median of a 5 x 5 neighbourhood, which shares the
 noise of a surface (leaves, a screen) without spreading a region's level
 over its border (a box filter carried a walker's raised level 2 pixels out,
@@ -76,7 +89,7 @@ def observed_median(magnitude, observed=None):
 
 
 def pixel_noise(residual, shape, observed=None, uniform=False, sample=None,
-                doubtful_floor=1.0):
+                doubtful_floor=1.0, offset_k=0.0):
     """
     Return each pixel's noise level ``sigma_p`` (n,) float32 from a window's residual.
 
@@ -100,14 +113,18 @@ def pixel_noise(residual, shape, observed=None, uniform=False, sample=None,
         the differences of consecutive columns where that is lower than the
         level of all its columns, but not below this share of it; 1: the
         level of all its columns (the module's docstring says why).
+    offset_k : float
+        A pixel whose level exceeds this multiple of the level of the
+        differences of its consecutive columns takes that level (an offset
+        of the model, not noise); 0: none does.
 
     """
     return magnitude_noise(np.abs(residual).max(axis=0), shape, observed, uniform, sample,
-                           residual, doubtful_floor)
+                           residual, doubtful_floor, offset_k)
 
 
 def magnitude_noise(magnitude, shape, observed=None, uniform=False, sample=None,
-                    residual=None, doubtful_floor=1.0):
+                    residual=None, doubtful_floor=1.0, offset_k=0.0):
     """
     Return :func:`pixel_noise` from the magnitude of the residual (n, m).
 
@@ -126,15 +143,18 @@ def magnitude_noise(magnitude, shape, observed=None, uniform=False, sample=None,
             median[doubtful] = observed_median(magnitude[doubtful])[0]
             count[doubtful] = magnitude.shape[1]
             if residual is not None and doubtful_floor < 1.0 and residual.shape[2] >= 3:
-                # Only the doubtful rows: a difference holds the noise of two columns.
-                differences = np.abs(np.diff(residual[:, doubtful], axis=2)).max(axis=0)
-                steps = row_median(differences) / math.sqrt(2.0)
+                steps = _step_medians(residual[:, doubtful])    # only the doubtful rows
                 median[doubtful] = np.maximum(np.minimum(median[doubtful], steps),
                                               doubtful_floor * median[doubtful])
     sigma = _MAD_TO_SIGMA * median
     seen = count >= MIN_OBSERVED
     typical = float(np.median(sigma[seen])) if np.any(seen) else robust_sigma(magnitude)
     typical = max(typical, _QUANTUM)
+    if offset_k and residual is not None and residual.shape[2] >= 3:
+        # After the typical level, which stays every pixel's floor (the module's docstring).
+        steps = _step_medians(residual)
+        offset = median > offset_k * steps
+        sigma[offset] = _MAD_TO_SIGMA * steps[offset]
     if uniform:
         return np.full(rows * cols, typical, dtype=np.float32)
     sigma = np.where(seen, np.maximum(sigma, typical), typical).astype(np.float32)
@@ -144,6 +164,17 @@ def magnitude_noise(magnitude, shape, observed=None, uniform=False, sample=None,
         sigma = sample.upsample(sigma)
     smooth = cv2.medianBlur(sigma.reshape(rows, cols), _NOISE_SMOOTHING)
     return smooth.ravel()
+
+
+def _step_medians(residual):
+    """
+    Return each row's median magnitude (n,) of the differences of consecutive columns.
+
+    The magnitude is the largest over the channels of ``residual`` (C, n, m),
+    divided by sqrt(2): a difference holds the noise of two columns.
+    """
+    differences = np.abs(np.diff(residual, axis=2)).max(axis=0)
+    return row_median(differences) / math.sqrt(2.0)
 
 
 def warmup_noise(frames):

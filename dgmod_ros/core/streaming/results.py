@@ -104,6 +104,7 @@ class WindowSnapshot:
     decision: str = 'global'    # likewise the decision rule ('adaptive' needs pixel noise)
     noise_source: str = 'solve'  # likewise the residual the pixel noise comes from
     doubtful_floor: float = 1.0  # likewise how far consecutive differences lower a level
+    offset_k: float = 0.0       # likewise the offset rule's multiple (pixel_k; 0: off)
     solve_shape: tuple = None   # (rows, cols, C) the window is solved at; None: ``shape``
     refit_background: bool = False  # refit each pixel's series on the solve's factors
     warm_start: bool = True     # start from ``previous``'s iterates where they fit

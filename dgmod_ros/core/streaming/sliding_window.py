@@ -180,7 +180,9 @@ class SlidingWindowDetector(StreamingDetector):
         1 reads the level of all its columns.
     pixel_k : float, default=6.0
         Multiple of the noise level that makes a pixel foreground ('adaptive',
-        'uniform').
+        'uniform'); also the multiple of a pixel's column-to-column level past
+        which its level in the window is an offset of the model, not noise
+        (:mod:`~dgmod_ros.core.streaming.noise_levels`).
     median_size : int, default=5
         Median filter of the adaptive decision at the processing size (odd;
         1 disables it).
@@ -848,6 +850,7 @@ class SlidingWindowDetector(StreamingDetector):
                               first_column=self.buffer_.first_column, decision=self.decision,
                               noise_source=self.noise_source,
                               doubtful_floor=float(self.doubtful_floor),
+                              offset_k=float(self.pixel_k),
                               solve_shape=solve_shape(self.shape_, int(self.solve_pixels),
                                                       float(self.solve_scale)),
                               refit_background=bool(self.refit_background),

@@ -100,7 +100,7 @@ def window_noise(snapshot, residuals, basis, observed, sample=None):
 
     def level(residual):
         return pixel_noise(residual, snapshot.shape, observed, uniform=uniform, sample=sample,
-                           doubtful_floor=snapshot.doubtful_floor)
+                           doubtful_floor=snapshot.doubtful_floor, offset_k=snapshot.offset_k)
 
     if source == 'solve':
         return level(residuals)
