@@ -115,8 +115,9 @@ def pixel_noise(residual, shape, observed=None, uniform=False, sample=None,
         level of all its columns (the module's docstring says why).
     offset_k : float
         A pixel whose level exceeds this multiple of the level of the
-        differences of its consecutive columns takes that level (an offset
-        of the model, not noise); 0: none does.
+        differences of its consecutive columns takes that level, but not
+        below the frame's typical level (an offset of the model, not
+        noise); 0: none does.
 
     """
     return magnitude_noise(np.abs(residual).max(axis=0), shape, observed, uniform, sample,
