@@ -138,22 +138,25 @@ def magnitude_noise(magnitude, shape, observed=None, uniform=False, sample=None,
     """
     rows, cols = shape[:2]
     median, count = observed_median(magnitude, observed)
+    stepped = residual is not None and residual.shape[2] >= 3
+    # Every row's steps once when the offset rule reads them; else the doubtful rows' only.
+    steps = _step_medians(residual) if stepped and offset_k else None
     if observed is not None:
         doubtful = count < magnitude.shape[1] / 2
         if doubtful.any():
             median[doubtful] = observed_median(magnitude[doubtful])[0]
             count[doubtful] = magnitude.shape[1]
-            if residual is not None and doubtful_floor < 1.0 and residual.shape[2] >= 3:
-                steps = _step_medians(residual[:, doubtful])    # only the doubtful rows
-                median[doubtful] = np.maximum(np.minimum(median[doubtful], steps),
+            if stepped and doubtful_floor < 1.0:
+                own = (steps[doubtful] if steps is not None
+                       else _step_medians(residual[:, doubtful]))
+                median[doubtful] = np.maximum(np.minimum(median[doubtful], own),
                                               doubtful_floor * median[doubtful])
     sigma = _MAD_TO_SIGMA * median
     seen = count >= MIN_OBSERVED
     typical = float(np.median(sigma[seen])) if np.any(seen) else robust_sigma(magnitude)
     typical = max(typical, _QUANTUM)
-    if offset_k and residual is not None and residual.shape[2] >= 3:
+    if steps is not None:
         # After the typical level, which stays every pixel's floor (the module's docstring).
-        steps = _step_medians(residual)
         offset = median > offset_k * steps
         sigma[offset] = _MAD_TO_SIGMA * steps[offset]
     if uniform:
