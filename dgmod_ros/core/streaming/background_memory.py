@@ -82,11 +82,22 @@ class BackgroundMemory(FrameWindow):
         self.admitted = 0               # columns admitted so far (warm-start bookkeeping)
         self.last_admitted_id = None
         self.filling = True             # every frame is admitted until the window is full
+        self.fill_end = None            # admission count at which the last fill ended
 
     @property
     def first_column(self):
         """Return the admission count of the oldest column (warm-start shifts)."""
         return self.admitted - len(self)
+
+    @property
+    def holds_fill(self):
+        """Tell whether the window still holds a column of its fill (admitted unconditionally)."""
+        return self.filling or self.first_column < self.fill_end
+
+    def _note_fill_end(self):
+        if self.filling and len(self) >= self.capacity:
+            self.fill_end = self.admitted
+        self.filling = self.filling and len(self) < self.capacity
 
     def wants(self, frame_id):
         """Tell whether the frame ``frame_id`` is due for admission."""
@@ -105,7 +116,7 @@ class BackgroundMemory(FrameWindow):
         self._observed.append(observed)
         self.admitted += 1
         self.last_admitted_id = frame_id
-        self.filling = self.filling and len(self) < self.capacity
+        self._note_fill_end()
 
     def observed(self):
         """Return the observed pixels of the columns (n, m) bool, or None when all are."""
@@ -140,6 +151,7 @@ class BackgroundMemory(FrameWindow):
             store.clear()
         self.last_admitted_id = None
         self.filling = True
+        self.fill_end = None
 
     def keep_newest(self, count):
         """Drop all but the newest ``count`` columns; return how many remain."""
@@ -157,7 +169,7 @@ class BackgroundMemory(FrameWindow):
         super().resize(capacity)
         self._observed = deque(self._observed, maxlen=int(capacity))
         self.kept = self.capacity if kept is None else min(int(kept), self.capacity)
-        self.filling = self.filling and len(self) < self.capacity
+        self._note_fill_end()
 
     def rescale(self, old_shape, new_shape):
         """Resample every column to ``new_shape``; every pixel counts as observed again."""

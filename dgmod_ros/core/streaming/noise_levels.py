@@ -36,6 +36,16 @@ decision. Such a pixel takes the level of its differences. Leaves and a
 flickering screen change from one column to the next and keep their level;
 a background that sways slowly (a period of seconds) reads as an offset
 too, which is this rule's price (docs/results.md).
+A pixel the conditional update has held out of half of the window's columns or
+more (something stands there, or the masks call its flicker foreground) has
+in those columns the model's own values, not the frame's, and their residual
+says nothing of its noise: read from them, a flickering plant's level fell to
+the typical pixel's, its flicker passed the threshold, was held out in turn,
+and the phantom grew for minutes (docs/results.md). Such a pixel keeps its
+last known level (:func:`known_levels`): the one read when a window of
+conditional admissions last observed it. A level read while the window
+still holds its fill, whose frames went in as they were, is not known: a
+person in view from the first frame is in it.
 No pixel is taken as quieter than the frame's typical pixel (the median of
 ``sigma_p`` over the frame, read before the offset rule: a recording that
 copies most blocks exactly has steps of 0 nearly everywhere, and its
@@ -89,7 +99,7 @@ def observed_median(magnitude, observed=None):
 
 
 def pixel_noise(residual, shape, observed=None, uniform=False, sample=None,
-                doubtful_floor=1.0, offset_k=0.0):
+                doubtful_floor=1.0, offset_k=0.0, known=None):
     """
     Return each pixel's noise level ``sigma_p`` (n,) float32 from a window's residual.
 
@@ -118,14 +128,18 @@ def pixel_noise(residual, shape, observed=None, uniform=False, sample=None,
         differences of its consecutive columns takes that level, but not
         below the frame's typical level (an offset of the model, not
         noise); 0: none does.
+    known : ndarray (n,) float32 or None
+        Each pixel's last known level (:func:`known_levels`; with
+        ``sample``, at its pixels (k,)), NaN where none: a pixel observed in
+        fewer than half of the columns takes it. None: none does.
 
     """
     return magnitude_noise(np.abs(residual).max(axis=0), shape, observed, uniform, sample,
-                           residual, doubtful_floor, offset_k)
+                           residual, doubtful_floor, offset_k, known)
 
 
 def magnitude_noise(magnitude, shape, observed=None, uniform=False, sample=None,
-                    residual=None, doubtful_floor=1.0, offset_k=0.0):
+                    residual=None, doubtful_floor=1.0, offset_k=0.0, known=None):
     """
     Return :func:`pixel_noise` from the magnitude of the residual (n, m).
 
@@ -141,8 +155,9 @@ def magnitude_noise(magnitude, shape, observed=None, uniform=False, sample=None,
     stepped = residual is not None and residual.shape[2] >= 3
     # Every row's steps once when the offset rule reads them; else the doubtful rows' only.
     steps = _step_medians(residual) if stepped and offset_k else None
+    doubtful = None
     if observed is not None:
-        doubtful = count < magnitude.shape[1] / 2
+        doubtful = _doubtful(count, magnitude.shape[1])
         if doubtful.any():
             median[doubtful] = observed_median(magnitude[doubtful])[0]
             count[doubtful] = magnitude.shape[1]
@@ -159,6 +174,11 @@ def magnitude_noise(magnitude, shape, observed=None, uniform=False, sample=None,
         # After the typical level, which stays every pixel's floor (the module's docstring).
         offset = median > offset_k * steps
         sigma[offset] = _MAD_TO_SIGMA * steps[offset]
+    if known is not None and doubtful is not None:
+        # After the typical level: a pixel held out by the masks does not set it.
+        carried = doubtful & np.isfinite(known)
+        sigma[carried] = known[carried]
+        seen |= carried
     if uniform:
         return np.full(rows * cols, typical, dtype=np.float32)
     sigma = np.where(seen, np.maximum(sigma, typical), typical).astype(np.float32)
@@ -168,6 +188,33 @@ def magnitude_noise(magnitude, shape, observed=None, uniform=False, sample=None,
         sigma = sample.upsample(sigma)
     smooth = cv2.medianBlur(sigma.reshape(rows, cols), _NOISE_SMOOTHING)
     return smooth.ravel()
+
+
+def known_levels(noise, observed, before=None, sample=None):
+    """
+    Return each pixel's last known level (n,) float32 after a solve; NaN where none.
+
+    ``noise`` (n,) is the solve's levels, ``observed`` (n, m) bool (with
+    ``sample``, (k, m) at its pixels) its window's observed entries (None:
+    all), ``before`` (n,) the known levels before it (None: none). A pixel
+    observed in at least half of the columns takes its new level; any other
+    keeps the one it had (the module's docstring); with ``sample``, a
+    pixel takes its new level only where every sampled pixel around it was
+    so observed. The caller passes only windows of conditional admissions.
+    """
+    if observed is None:
+        return np.asarray(noise, dtype=np.float32).copy()
+    doubtful = _doubtful(observed.sum(axis=1), observed.shape[1]).astype(np.float32)
+    if sample is not None:
+        doubtful = sample.upsample(doubtful)    # exactly 0 where no sampled neighbour is
+    if before is None:
+        before = np.full(noise.shape, np.nan, dtype=np.float32)
+    return np.where(doubtful == 0, noise, before).astype(np.float32)
+
+
+def _doubtful(count, columns):
+    """Return the pixels observed in fewer than half of ``columns`` columns (``count`` (n,))."""
+    return count < columns / 2
 
 
 def _step_medians(residual):

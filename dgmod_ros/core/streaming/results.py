@@ -100,6 +100,7 @@ class WindowSnapshot:
     basis_rank: int             # likewise the fast path's basis size
     ticket: SolveTicket = None
     observed: np.ndarray = None  # (n, m) bool: entries the noise levels count; None: all
+    holds_fill: bool = True     # a column of the window's fill is still in it
     first_column: int = None    # admission count of the oldest column (warm-start shift)
     decision: str = 'global'    # likewise the decision rule ('adaptive' needs pixel noise)
     noise_source: str = 'solve'  # likewise the residual the pixel noise comes from
@@ -170,6 +171,11 @@ class BackgroundModel:
         Each pixel's noise level (the adaptive decision), None for the global rule.
     chroma_noise : ndarray (n,) or None
         Each pixel's chromaticity noise level (the lighting test, colour only).
+    known_noise : ndarray (n,) or None
+        Each pixel's last level read from a window of conditional admissions
+        in which it was observed (NaN: none yet;
+        :func:`~dgmod_ros.core.streaming.noise_levels.known_levels`); None
+        before the first such window and for the global rule.
     first_column : int or None
         Admission count of the window's oldest column.
     solve_shape : tuple or None
@@ -196,5 +202,6 @@ class BackgroundModel:
     noise: np.ndarray = None
     first_column: int = None
     chroma_noise: np.ndarray = None
+    known_noise: np.ndarray = None
     solve_shape: tuple = None
     fit_basis: np.ndarray = None

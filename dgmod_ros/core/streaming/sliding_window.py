@@ -847,6 +847,7 @@ class SlidingWindowDetector(StreamingDetector):
                               model=self.model_, mask_rule=self.mask_rule_,
                               basis_rank=int(self.basis_rank), ticket=self._ticket(),
                               observed=self.buffer_.observed(),
+                              holds_fill=self.buffer_.holds_fill,
                               first_column=self.buffer_.first_column, decision=self.decision,
                               noise_source=self.noise_source,
                               doubtful_floor=float(self.doubtful_floor),

@@ -9,7 +9,7 @@ import cv2
 import numpy as np
 
 from .fast_path import background_basis, projection_residual, sampled_basis
-from .noise_levels import pixel_noise
+from .noise_levels import known_levels, pixel_noise
 from .photometric import chroma_noise
 from .results import BackgroundModel, SolverFailure
 from .solve_resolution import carry_backgrounds, downsample_window, PixelSample
@@ -83,7 +83,16 @@ def _sampled(sample, array):
     return array if sample is None or array is None else sample.take(array)
 
 
-def window_noise(snapshot, residuals, basis, observed, sample=None):
+def previous_known(snapshot):
+    """Return the previous solve's known levels (n,) when it has the snapshot's shape, or None."""
+    previous = snapshot.previous
+    if (previous is None or previous.known_noise is None
+            or tuple(previous.shape) != tuple(snapshot.shape)):
+        return None
+    return previous.known_noise
+
+
+def window_noise(snapshot, residuals, basis, observed, sample=None, known=None):
     """
     Return each pixel's noise level from the residual ``snapshot.noise_source`` names.
 
@@ -93,14 +102,16 @@ def window_noise(snapshot, residuals, basis, observed, sample=None):
     larger of the 'solve' and 'projection' levels. With a
     :class:`~.solve_resolution.PixelSample`, the levels are read at its
     pixels (``residuals`` and ``observed``, the snapshot's observed entries,
-    hold those only) and upsampled.
+    hold those only, and ``known``, the previous solve's known levels, if
+    any) and upsampled.
     """
     uniform = snapshot.decision == 'uniform'
     source = snapshot.noise_source
 
     def level(residual):
         return pixel_noise(residual, snapshot.shape, observed, uniform=uniform, sample=sample,
-                           doubtful_floor=snapshot.doubtful_floor, offset_k=snapshot.offset_k)
+                           doubtful_floor=snapshot.doubtful_floor, offset_k=snapshot.offset_k,
+                           known=known)
 
     if source == 'solve':
         return level(residuals)
@@ -176,7 +187,7 @@ def solve_window(snapshot):
     basis = np.zeros((channels, rows * cols, max(b.shape[1] for b in bases)), dtype=np.float32)
     for channel, channel_basis in enumerate(bases):
         basis[channel, :, :channel_basis.shape[1]] = channel_basis
-    noise = chroma = threshold = None
+    noise = chroma = threshold = known = None
     if snapshot.decision != 'global':
         # A downscaled solve reads its levels at one full-size pixel per
         # solved one, and needs its residual there only.
@@ -188,7 +199,12 @@ def solve_window(snapshot):
         observed = _sampled(sample, snapshot.observed)
         if carried:
             residuals = carry.residuals(sampled, None if sample is None else sample.pixels)
-        noise = window_noise(snapshot, residuals, basis, observed, sample)
+        known = previous_known(snapshot)
+        noise = window_noise(snapshot, residuals, basis, observed, sample,
+                             known if known is None or sample is None else known[sample.pixels])
+        if not snapshot.holds_fill:
+            # A window that still holds its fill may hold a person in view from the start.
+            known = known_levels(noise, observed, known, sample)
         if channels == 3:
             chroma = chroma_noise(sampled, residuals, snapshot.shape, observed,
                                   snapshot.decision == 'uniform', sample)
@@ -204,5 +220,5 @@ def solve_window(snapshot):
         shape=snapshot.shape, first_id=snapshot.first_id, last_id=snapshot.last_id,
         states=separated.states, seconds=time.perf_counter() - started,
         iterations=separated.iterations, info=separated.info, ticket=snapshot.ticket,
-        noise=noise, first_column=snapshot.first_column, chroma_noise=chroma,
+        noise=noise, first_column=snapshot.first_column, chroma_noise=chroma, known_noise=known,
         solve_shape=small_shape, fit_basis=sampled_basis(basis))
