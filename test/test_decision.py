@@ -13,6 +13,7 @@ from dgmod_ros.core.streaming.ghost import ghost_parts
 from dgmod_ros.core.streaming.held_foreground import (came_in, consecutive_frames, moved_inside,
                                                       still_blob_pixels)
 from dgmod_ros.core.streaming.noise_levels import known_levels, pixel_noise, warmup_noise
+from dgmod_ros.core.streaming.solve_resolution import PixelSample
 from dgmod_ros.core.streaming.window_solve import healed_starts
 from dgmod_ros.core.synthetic import textured_background
 import numpy as np
@@ -863,6 +864,20 @@ def test_known_levels_take_the_new_level_where_the_pixel_was_observed_in_half_th
     assert np.allclose(known_levels(noise, observed, before), [0.1, 0.6, np.nan],
                        equal_nan=True)
     assert np.allclose(known_levels(noise, None, before), noise)   # every entry observed
+
+
+def test_known_levels_of_a_downscaled_solve_keep_the_old_level_around_a_doubtful_sample():
+    # An 8 x 8 frame read at every other pixel (4 x 4): the sampled pixel at
+    # (1, 1) was held out of 3 of 4 columns. The frame's pixels whose upsampled
+    # level it enters (a 3 x 3 corner) keep their known level; the rest take the new.
+    sample = PixelSample((8, 8, 1), (4, 4, 1))
+    observed = np.ones((16, 4), bool)
+    observed[0, :3] = False
+    noise = np.full(64, 0.1, np.float32)
+    known = known_levels(noise, observed, np.full(64, 0.5, np.float32), sample).reshape(8, 8)
+    corner = np.zeros((8, 8), bool)
+    corner[:3, :3] = True
+    assert np.all(known[corner] == 0.5) and np.all(known[~corner] == np.float32(0.1))
 
 
 def test_the_window_holds_its_fill_until_the_last_fill_column_has_left():
