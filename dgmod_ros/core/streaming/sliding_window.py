@@ -35,6 +35,8 @@ from ..masks import MaskRule
 from ..preprocess import frame_columns, processing_shape
 from ..validation import validate_params
 
+# Share of outliers past which an l1 fit is pulled by them (the median's breakdown point).
+_L1_BREAKDOWN = 0.5
 # Frames back to the frame that tells whether a blob is still (the ghost test).
 _GHOST_LAG = 5
 # Growth of the foreground before the conditional update (processing pixels).
@@ -496,28 +498,36 @@ class SlidingWindowDetector(StreamingDetector):
         Return ``background``, or the fit without the previous frame's foreground if that fits.
 
         An l1 fit breaks down once a person covers about half of the view:
-        the whole frame then reads as changed, and the scene-change rule
-        would restart the window from frames of the person, whose background
-        is the person from then on. Where the whole frame's fit reads as a
-        scene change (over ``global_change_fraction`` of the pixels off it by
-        ``pixel_k`` noise levels), the fit is tried again without the pixels
-        the previous frame called foreground; if that one does not read as a
-        scene change, a large person pulled the first. Only then, not in
-        every fit: a region wrongly called foreground (a corner a change of
-        light left as it was), left out of every fit, keeps itself foreground.
+        pulled towards him, it reads much of the frame as changed. Past
+        ``global_change_fraction`` of the pixels the scene-change rule would
+        restart the window from frames of the person, whose background is
+        the person from then on; short of it, the pulled fit calls the place
+        around him foreground. Where the whole frame's fit leaves more than
+        half of the pixels off it by ``pixel_k`` noise levels (its breakdown
+        point, or the scene-change share where that is lower), the fit is
+        tried again without the pixels the previous frame called foreground.
+        It is taken where it holds: no more than half of the pixels it was
+        fit to are off it (a large person pulled the first fit; light
+        switched over most of the view leaves the rest off as well), and it
+        leaves fewer pixels off than the first. Only then, not in every fit:
+        a region wrongly called foreground (a corner a change of light left
+        as it was), left out of every fit, keeps itself foreground.
         """
         if self.previous_foreground_ is None:
             return background
         bound = self.pixel_k * np.asarray(model.noise, dtype=np.float32)
-
-        def changed_share(fitted):
-            return np.count_nonzero(_change(columns, fitted) > bound) / bound.size
-
-        if changed_share(background) <= self.global_change_fraction:
+        pulled = np.count_nonzero(_change(columns, background) > bound)
+        if pulled <= min(_L1_BREAKDOWN, self.global_change_fraction) * bound.size:
             return background
+        rest = ~self.previous_foreground_
         unpulled = robust_projection(model.basis, columns, fit_basis=model.fit_basis,
                                      left_out=self.previous_foreground_)
-        return unpulled if changed_share(unpulled) <= self.global_change_fraction else background
+        changed = _change(columns, unpulled) > bound
+        # Taken where it holds on the pixels it was fit to (under the breakdown
+        # point there) and leaves fewer pixels off than the whole frame's fit.
+        holds = np.count_nonzero(changed & rest) <= _L1_BREAKDOWN * np.count_nonzero(rest)
+        fewer = np.count_nonzero(changed) < pulled
+        return unpulled if holds and fewer else background
 
     def _finish(self, pending):
         # The stages in the order a frame passes them (the package docstring's list).
