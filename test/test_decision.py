@@ -243,6 +243,11 @@ def test_the_window_heals_where_a_ghost_was_dropped():
     assert detector.buffer_.first_id < 40       # columns of the frames that held the box too
 
 
+def _rgb8(grey):
+    """Return a grey image in [0, 1] (rows, cols) as an rgb8 frame, rounded."""
+    return np.clip(np.repeat(grey[:, :, None], 3, 2) * 255 + 0.5, 0, 255).astype(np.uint8)
+
+
 def test_a_pacer_from_the_first_frame_leaves_no_trail_in_the_background():
     # A dark shape in view from the first frame paces over 40 columns at 2
     # pixels a frame: each pixel of its span is covered a third of the time
@@ -260,8 +265,7 @@ def test_a_pacer_from_the_first_frame_leaves_no_trail_in_the_background():
         left = 40 + (phase if phase < 40 else 80 - phase)
         grey[30:80, left:left + 14] = 0.1
         grey += rng.normal(0.0, 0.01, grey.shape)
-        detector.process(np.clip(np.repeat(grey[:, :, None], 3, 2) * 255 + 0.5, 0, 255)
-                         .astype(np.uint8))
+        detector.process(_rgb8(grey))
     off = np.abs(detector.background_image().mean(axis=2) - wall)[30:80, 40:94]
     assert (off > 0.1).mean() < 0.05
 
@@ -286,8 +290,7 @@ def _walker_from_the_first_frame(frames, flicker, seed=5):
         if flicker:
             grey[4:24, 60:124] += rng.uniform(-0.12, 0.12, (20, 64))
         grey += rng.normal(0.0, 0.01, grey.shape)
-        image = np.clip(np.repeat(grey[:, :, None], 3, 2) * 255 + 0.5, 0, 255)
-        yield image.astype(np.uint8), truth
+        yield _rgb8(grey), truth
 
 
 def _walker_masks(frames, flicker):
@@ -344,8 +347,7 @@ def test_a_person_who_walks_up_while_the_window_fills_and_stands_stays_foregroun
             truth[30:80, left:left + 16] = True
             grey[truth] = 0.1
         grey += rng.normal(0.0, 0.01, grey.shape)
-        image = np.clip(np.repeat(grey[:, :, None], 3, 2) * 255 + 0.5, 0, 255)
-        mask = detector.process(image.astype(np.uint8))[0].mask > 0
+        mask = detector.process(_rgb8(grey))[0].mask > 0
         if t >= 90:
             recall.append(mask[truth].mean())
     assert np.mean(recall) > 0.9
@@ -375,8 +377,7 @@ def test_a_body_covering_most_of_the_view_stays_foreground_when_it_pulls_the_fit
             truth[:, left:left + 3 * cols // 5] = True
             grey[truth] = 0.3 + 0.02 * np.sin(t)
         grey += rng.normal(0.0, 0.01, grey.shape)
-        image = np.clip(np.repeat(grey[:, :, None], 3, 2) * 255 + 0.5, 0, 255)
-        mask = detector.process(image.astype(np.uint8))[0].mask > 0
+        mask = detector.process(_rgb8(grey))[0].mask > 0
         if t >= 80:
             recall.append(mask[truth].mean())
             wall_share.append(mask[~truth].mean())
